@@ -1,0 +1,6 @@
+//! One module per subcommand group.
+
+pub mod cem;
+pub mod design;
+pub mod fe;
+pub mod robot;

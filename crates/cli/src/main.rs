@@ -1,0 +1,56 @@
+//! `kappe`: design 3D-printed cap ceilings and plan the robot that prints them.
+//!
+//! The binary is thin on purpose: it parses arguments, calls the library crates,
+//! writes files atomically and prints. Each subcommand lives in `cmd/<name>.rs`.
+
+mod cmd;
+mod output;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "kappe", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Combinatorial Equilibrium Modeling: solve or form-find a topology (kappe.cem.topology JSON).
+    #[command(subcommand)]
+    Cem(cmd::cem::CemCommand),
+    /// Shell finite elements: linear statics and linear buckling of a mesh (fixture JSON format).
+    #[command(subcommand)]
+    Fe(cmd::fe::FeCommand),
+    /// UR10e kinematics and robot plans.
+    #[command(subcommand)]
+    Robot(cmd::robot::RobotCommand),
+    /// Design a cap ceiling: form-find every print state, analyse, write outputs.
+    Design(cmd::design::DesignArgs),
+    /// Write a commented example design file.
+    Init(cmd::design::InitArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Cem(c) => cmd::cem::run(c),
+        Command::Fe(c) => cmd::fe::run(c),
+        Command::Robot(c) => cmd::robot::run(c),
+        Command::Design(a) => cmd::design::run(a),
+        Command::Init(a) => cmd::design::init(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("error: {err}");
+            for cause in err.chain().skip(1) {
+                eprintln!("  caused by: {cause}");
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
