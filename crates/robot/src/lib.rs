@@ -1,1 +1,11 @@
-//! (work in progress)
+//! `kappe-robot`: UR10e kinematics, capsule collision, print-path motion planning and robot
+//! programs for printing vaulted cap ceilings (paper §3.4; spec in `shared/reference/robot.md`).
+//!
+//! Frames follow the rerun naming `a_from_b` ([`frames`]). The base frame is the UR DH base
+//! (controller Base), the flange is DH frame 6, a TCP pose is `base_from_flange · flange_from_tcp`.
+
+pub mod frames;
+pub mod kinematics;
+
+pub use frames::{Iso, Mat4};
+pub use kinematics::{Dh, IkSolutions, Joints, UR10E};

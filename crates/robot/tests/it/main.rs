@@ -1,0 +1,5 @@
+//! Integration tests of `kappe-robot` against the fixtures in `shared/fixtures/robot/`
+//! (robot.md §7 acceptance checks).
+
+mod common;
+mod kinematics;
