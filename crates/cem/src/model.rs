@@ -1,0 +1,570 @@
+//! Trail building and validation (cem.md §2): from a [`Topology`] to a [`Model`], the
+//! flat, index-based form the solver sweeps over.
+//!
+//! Steps, in order:
+//! 1. element checks: unique finite nodes, known edge ends, no self loops, one edge per pair;
+//! 2. auxiliary trails (if enabled): every non-support node without a trail edge gets a new
+//!    support `max_id + 1, …` (ascending in the id of the node it hangs from) and a trail edge
+//!    of the auxiliary length;
+//! 3. trails: from each support in node order, walk trail edges to the far end, the origin.
+//!    A support with **no** trail edge is a *reaction node*: a one-node trail whose origin is
+//!    the support itself. Its position is prescribed (like any origin) and its reaction is
+//!    `R = −q − D` (Kappe's extension over compas_cem, needed for the cap's arch feet);
+//! 4. trail shifts; a reaction node without an explicit shift takes the largest sequence of
+//!    the trail nodes it is joined to by deviation edges (or 0), so that it is processed
+//!    together with them and its edges are direct when the neighbours share one sequence;
+//! 5. direct/indirect classification (`k(u) == k(v)`) and the step schedule: for `k = 0..=K`,
+//!    for each trail in trail order, the node of that trail at sequence `k`.
+//!
+//! Everything compas_cem accepts silently but gets wrong (two supports on one chain,
+//! T-junctions, cycles, supports inside a trail) is a typed [`CemError`] here.
+
+use std::collections::HashMap;
+
+use nalgebra::Vector3;
+
+use crate::error::CemError;
+use crate::topology::{NodeId, Topology};
+
+/// One node step of a sweep: the node, and for non-supports the outgoing trail edge and the
+/// next node of the trail.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Step {
+    pub node: usize,
+    pub out: Option<(usize, usize)>,
+}
+
+/// A deviation-edge entry of a node's adjacency list.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Adj {
+    pub other: usize,
+    pub edge: usize,
+}
+
+/// A plane with a unit normal, for plane-cut trail edges.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct UnitPlane {
+    pub origin: Vector3<f64>,
+    pub normal: Vector3<f64>,
+}
+
+/// A trail as built: node indices from origin to support, the trail edge index between
+/// consecutive nodes, and the sequence of its origin.
+#[derive(Debug, Clone)]
+pub(crate) struct TrailData {
+    pub nodes: Vec<usize>,
+    pub edges: Vec<usize>,
+    pub start: usize,
+}
+
+/// An auxiliary trail added by the model: (node index, aux node index).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AuxData {
+    pub node: usize,
+    pub aux: usize,
+}
+
+/// A validated topology with its trails, sequences and schedule, ready to be solved many
+/// times (with changed lengths, forces, loads or origin positions).
+///
+/// Node indices: the topology's nodes in order, then the auxiliary nodes. Trail-edge
+/// indices: the topology's trail edges in order, then the auxiliary edges. Deviation-edge
+/// indices: as in the topology.
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub(crate) name: String,
+    pub(crate) ids: Vec<NodeId>,
+    pub(crate) index: HashMap<NodeId, usize>,
+    pub(crate) xyz0: Vec<Vector3<f64>>,
+    pub(crate) loads: Vec<Vector3<f64>>,
+    pub(crate) is_support: Vec<bool>,
+    pub(crate) is_origin: Vec<bool>,
+    pub(crate) sequence: Vec<usize>,
+    pub(crate) trail_u: Vec<usize>,
+    pub(crate) trail_v: Vec<usize>,
+    pub(crate) lengths: Vec<f64>,
+    pub(crate) planes: Vec<Option<UnitPlane>>,
+    pub(crate) dev_u: Vec<usize>,
+    pub(crate) dev_v: Vec<usize>,
+    pub(crate) forces: Vec<f64>,
+    pub(crate) direct: Vec<bool>,
+    pub(crate) trails: Vec<TrailData>,
+    pub(crate) steps: Vec<Step>,
+    /// CSR adjacency of deviation edges: node `n` owns `adj[adj_start[n]..adj_start[n+1]]`,
+    /// direct entries first, indirect ones from `adj_split[n]`.
+    pub(crate) adj_start: Vec<usize>,
+    pub(crate) adj_split: Vec<usize>,
+    pub(crate) adj: Vec<Adj>,
+    pub(crate) has_indirect: bool,
+    pub(crate) aux: Vec<AuxData>,
+    pub(crate) n_input_trail_edges: usize,
+}
+
+fn finite(what: impl FnOnce() -> String, value: f64) -> Result<(), CemError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(CemError::NonFinite {
+            what: what(),
+            value,
+        })
+    }
+}
+
+fn finite3(what: impl Fn() -> String, v: &Vector3<f64>) -> Result<(), CemError> {
+    for (i, c) in v.iter().enumerate() {
+        finite(|| format!("{}[{i}]", what()), *c)?;
+    }
+    Ok(())
+}
+
+/// Element-level checks shared by [`crate::TopologyBuilder::build`] and [`Model::new`].
+pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, CemError> {
+    let mut index = HashMap::with_capacity(topo.nodes.len());
+    for (i, n) in topo.nodes.iter().enumerate() {
+        if index.insert(n.id, i).is_some() {
+            return Err(CemError::DuplicateNode { id: n.id });
+        }
+        finite3(|| format!("node {} xyz", n.id), &n.xyz)?;
+        finite3(|| format!("node {} load", n.id), &n.load)?;
+    }
+    let mut pairs: HashMap<(NodeId, NodeId), String> = HashMap::new();
+    let mut check_pair = |kind: &'static str, u: NodeId, v: NodeId| -> Result<(), CemError> {
+        for id in [u, v] {
+            if !index.contains_key(&id) {
+                return Err(CemError::UnknownNode {
+                    id,
+                    context: format!("{kind} edge ({u}, {v})"),
+                });
+            }
+        }
+        if u == v {
+            return Err(CemError::SelfLoop { kind, u });
+        }
+        let key = (u.min(v), u.max(v));
+        let desc = format!("{kind} edge ({u}, {v})");
+        if let Some(first) = pairs.insert(key, desc.clone()) {
+            return Err(CemError::DuplicateEdge {
+                u,
+                v,
+                first,
+                second: desc,
+            });
+        }
+        Ok(())
+    };
+    for e in &topo.trail_edges {
+        check_pair("trail", e.u, e.v)?;
+        finite(|| format!("trail edge ({}, {}) length", e.u, e.v), e.length)?;
+        if let Some(p) = &e.plane {
+            finite3(
+                || format!("trail edge ({}, {}) plane origin", e.u, e.v),
+                &p.origin,
+            )?;
+            finite3(
+                || format!("trail edge ({}, {}) plane normal", e.u, e.v),
+                &p.normal,
+            )?;
+            if p.normal.norm() == 0.0 {
+                return Err(CemError::ZeroPlaneNormal { u: e.u, v: e.v });
+            }
+        }
+    }
+    for e in &topo.deviation_edges {
+        check_pair("deviation", e.u, e.v)?;
+        finite(
+            || format!("deviation edge ({}, {}) force", e.u, e.v),
+            e.force,
+        )?;
+    }
+    if let Some(aux) = &topo.auxiliary_trails {
+        finite(|| "auxiliary_trails.length".to_string(), aux.length)?;
+        finite3(|| "auxiliary_trails.vector".to_string(), &aux.vector)?;
+    }
+    for s in &topo.trail_shifts {
+        if !index.contains_key(&s.origin) {
+            return Err(CemError::UnknownNode {
+                id: s.origin,
+                context: "trail shift".to_string(),
+            });
+        }
+    }
+    Ok(index)
+}
+
+/// compas `normalize_vector`: v/‖v‖, and the zero vector for v = 0.
+fn unit_f64(v: Vector3<f64>) -> Vector3<f64> {
+    let n = v.norm();
+    if n == 0.0 { v } else { v / n }
+}
+
+impl Model {
+    /// Validate `topo`, build its trails and the solve schedule (see the module docs).
+    pub fn new(topo: &Topology) -> Result<Self, CemError> {
+        let mut index = check_elements(topo)?;
+
+        let mut ids: Vec<NodeId> = topo.nodes.iter().map(|n| n.id).collect();
+        let mut xyz0: Vec<Vector3<f64>> = topo.nodes.iter().map(|n| n.xyz).collect();
+        let mut loads: Vec<Vector3<f64>> = topo.nodes.iter().map(|n| n.load).collect();
+        let mut is_support: Vec<bool> = topo.nodes.iter().map(|n| n.support).collect();
+        let mut trail_u = Vec::with_capacity(topo.trail_edges.len());
+        let mut trail_v = Vec::with_capacity(topo.trail_edges.len());
+        let mut lengths = Vec::with_capacity(topo.trail_edges.len());
+        let mut planes = Vec::with_capacity(topo.trail_edges.len());
+        for e in &topo.trail_edges {
+            // Ends are known: check_elements verified them.
+            trail_u.push(index.get(&e.u).copied().unwrap_or_default());
+            trail_v.push(index.get(&e.v).copied().unwrap_or_default());
+            lengths.push(e.length);
+            planes.push(e.plane.map(|p| UnitPlane {
+                origin: p.origin,
+                normal: p.normal / p.normal.norm(),
+            }));
+        }
+        let n_input_trail_edges = trail_u.len();
+
+        let mut degree = vec![0usize; ids.len()];
+        for (&u, &v) in trail_u.iter().zip(&trail_v) {
+            degree[u] += 1;
+            degree[v] += 1;
+        }
+
+        // Auxiliary trails for non-support nodes without trail edges.
+        let mut aux = Vec::new();
+        if let Some(a) = &topo.auxiliary_trails {
+            let mut hang: Vec<usize> = (0..ids.len())
+                .filter(|&i| degree[i] == 0 && !is_support[i])
+                .collect();
+            hang.sort_by_key(|&i| ids[i]);
+            let mut next_id = ids.iter().copied().max().unwrap_or(0);
+            let dir = unit_f64(a.vector);
+            for i in hang {
+                next_id = next_id.checked_add(1).ok_or(CemError::InvalidOption {
+                    name: "auxiliary node id",
+                    value: next_id as f64,
+                    allowed: "node ids must leave room for auxiliary node ids below u64::MAX",
+                })?;
+                let k = ids.len();
+                ids.push(next_id);
+                index.insert(next_id, k);
+                xyz0.push(xyz0[i] + dir * a.length);
+                loads.push(Vector3::zeros());
+                is_support.push(true);
+                degree.push(1);
+                degree[i] += 1;
+                aux.push(AuxData { node: i, aux: k });
+                trail_u.push(i);
+                trail_v.push(k);
+                lengths.push(a.length);
+                planes.push(None);
+            }
+        }
+        let n = ids.len();
+
+        // Trail adjacency, at most two trail edges per node.
+        let mut tadj: Vec<[(usize, usize); 2]> = vec![[(usize::MAX, usize::MAX); 2]; n];
+        let mut tdeg = vec![0usize; n];
+        for (e, (&u, &v)) in trail_u.iter().zip(&trail_v).enumerate() {
+            for (a, b) in [(u, v), (v, u)] {
+                if tdeg[a] >= 2 {
+                    let edges: Vec<String> = (0..trail_u.len())
+                        .filter(|&k| trail_u[k] == a || trail_v[k] == a)
+                        .map(|k| format!("({}, {})", ids[trail_u[k]], ids[trail_v[k]]))
+                        .collect();
+                    return Err(CemError::NodeOnTwoTrails {
+                        id: ids[a],
+                        count: edges.len(),
+                        edges: edges.join(", "),
+                    });
+                }
+                tadj[a][tdeg[a]] = (e, b);
+                tdeg[a] += 1;
+            }
+        }
+
+        if !is_support.iter().any(|&s| s) {
+            // compas checks supports before unassigned nodes ("No supports assigned!").
+            return Err(CemError::NoSupport);
+        }
+
+        // Walk from each support in node order.
+        let mut visited = vec![false; n];
+        let mut trails: Vec<TrailData> = Vec::new();
+        for s in 0..n {
+            if !is_support[s] {
+                continue;
+            }
+            if tdeg[s] == 2 {
+                return Err(CemError::SupportInsideTrail { id: ids[s] });
+            }
+            let mut nodes = vec![s];
+            let mut edges = Vec::new();
+            visited[s] = true;
+            let mut cur = s;
+            let mut prev_edge = usize::MAX;
+            loop {
+                let next = tadj[cur][..tdeg[cur]]
+                    .iter()
+                    .copied()
+                    .find(|&(e, _)| e != prev_edge);
+                let Some((e, m)) = next else { break };
+                if is_support[m] {
+                    return Err(CemError::TrailWithTwoSupports {
+                        first: ids[s],
+                        second: ids[m],
+                    });
+                }
+                // Degree ≤ 2 and the walk starts at a degree-1 end, so it cannot revisit;
+                // keep the check anyway as a guard against an infinite loop.
+                if visited[m] {
+                    return Err(CemError::TrailCycle {
+                        nodes: nodes.iter().map(|&i| ids[i]).collect(),
+                    });
+                }
+                visited[m] = true;
+                nodes.push(m);
+                edges.push(e);
+                prev_edge = e;
+                cur = m;
+            }
+            nodes.reverse();
+            edges.reverse();
+            trails.push(TrailData {
+                nodes,
+                edges,
+                start: 0,
+            });
+        }
+
+        if let Some(first) = (0..n).find(|&i| !visited[i]) {
+            if tdeg[first] == 0 {
+                return Err(CemError::UnassignedNode { id: ids[first] });
+            }
+            // Collect the connected chain of trail edges through `first`.
+            let mut comp = vec![first];
+            let mut seen = vec![first];
+            let mut stack = vec![first];
+            while let Some(a) = stack.pop() {
+                for &(_, b) in &tadj[a][..tdeg[a]] {
+                    if !seen.contains(&b) {
+                        seen.push(b);
+                        comp.push(b);
+                        stack.push(b);
+                    }
+                }
+            }
+            let nodes: Vec<NodeId> = comp.iter().map(|&i| ids[i]).collect();
+            return Err(if comp.iter().all(|&i| tdeg[i] == 2) {
+                CemError::TrailCycle { nodes }
+            } else {
+                CemError::TrailWithoutSupport { nodes }
+            });
+        }
+
+        let mut is_origin = vec![false; n];
+        for t in &trails {
+            if let Some(&o) = t.nodes.first() {
+                is_origin[o] = true;
+            }
+        }
+        for (i, node) in topo.nodes.iter().enumerate() {
+            if let Some(given) = node.origin
+                && given != is_origin[i]
+            {
+                return Err(CemError::OriginMismatch {
+                    id: node.id,
+                    given,
+                    derived: if is_origin[i] {
+                        "an origin"
+                    } else {
+                        "a non-origin node"
+                    },
+                });
+            }
+        }
+
+        // Sequences and shifts.
+        let mut trail_of_origin: HashMap<usize, usize> = HashMap::new();
+        for (k, t) in trails.iter().enumerate() {
+            if let Some(&o) = t.nodes.first() {
+                trail_of_origin.insert(o, k);
+            }
+        }
+        let mut shifted = vec![false; trails.len()];
+        for s in &topo.trail_shifts {
+            let o = index.get(&s.origin).copied().unwrap_or(usize::MAX);
+            let Some(&k) = trail_of_origin.get(&o) else {
+                return Err(CemError::ShiftNotOrigin { id: s.origin });
+            };
+            if shifted[k] {
+                return Err(CemError::DuplicateShift { id: s.origin });
+            }
+            shifted[k] = true;
+            trails[k].start = s.start;
+        }
+        let mut sequence = vec![0usize; n];
+        for t in &trails {
+            for (j, &node) in t.nodes.iter().enumerate() {
+                sequence[node] = t.start + j;
+            }
+        }
+        let dev_u: Vec<usize> = topo
+            .deviation_edges
+            .iter()
+            .map(|e| index.get(&e.u).copied().unwrap_or_default())
+            .collect();
+        let dev_v: Vec<usize> = topo
+            .deviation_edges
+            .iter()
+            .map(|e| index.get(&e.v).copied().unwrap_or_default())
+            .collect();
+        let forces: Vec<f64> = topo.deviation_edges.iter().map(|e| e.force).collect();
+
+        // Reaction nodes follow the sequence of their (trail) neighbours.
+        let is_reaction: Vec<bool> = (0..n).map(|i| is_support[i] && tdeg[i] == 0).collect();
+        let mut reaction_seq: Vec<Option<usize>> = vec![None; n];
+        for (&u, &v) in dev_u.iter().zip(&dev_v) {
+            for (a, b) in [(u, v), (v, u)] {
+                if is_reaction[a] && !is_reaction[b] {
+                    let s = reaction_seq[a].map_or(sequence[b], |s| s.max(sequence[b]));
+                    reaction_seq[a] = Some(s);
+                }
+            }
+        }
+        for (k, t) in trails.iter_mut().enumerate() {
+            if let [only] = t.nodes[..]
+                && is_reaction[only]
+                && !shifted[k]
+            {
+                t.start = reaction_seq[only].unwrap_or(0);
+                sequence[only] = t.start;
+            }
+        }
+
+        // Deviation adjacency (CSR), direct entries first.
+        let direct: Vec<bool> = dev_u
+            .iter()
+            .zip(&dev_v)
+            .map(|(&u, &v)| sequence[u] == sequence[v])
+            .collect();
+        let has_indirect = direct.iter().any(|d| !d);
+        let mut count = vec![0usize; n + 1];
+        for (&u, &v) in dev_u.iter().zip(&dev_v) {
+            count[u + 1] += 1;
+            count[v + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let adj_start = count;
+        let mut fill = adj_start.clone();
+        let mut adj = vec![Adj { other: 0, edge: 0 }; adj_start[n]];
+        for pass_direct in [true, false] {
+            for (e, (&u, &v)) in dev_u.iter().zip(&dev_v).enumerate() {
+                if direct[e] != pass_direct {
+                    continue;
+                }
+                for (a, b) in [(u, v), (v, u)] {
+                    adj[fill[a]] = Adj { other: b, edge: e };
+                    fill[a] += 1;
+                }
+            }
+        }
+        let mut adj_split = vec![0usize; n];
+        for i in 0..n {
+            let range = adj_start[i]..adj_start[i + 1];
+            adj_split[i] = range.start
+                + adj[range.clone()]
+                    .iter()
+                    .take_while(|a| direct[a.edge])
+                    .count();
+        }
+
+        // Schedule: k-major, trail order within a sequence (stable sort keeps trail order).
+        let mut steps: Vec<(usize, Step)> = Vec::with_capacity(n);
+        for t in &trails {
+            for (j, &node) in t.nodes.iter().enumerate() {
+                let out = match (t.edges.get(j), t.nodes.get(j + 1)) {
+                    (Some(&e), Some(&next)) => Some((e, next)),
+                    _ => None,
+                };
+                steps.push((t.start + j, Step { node, out }));
+            }
+        }
+        steps.sort_by_key(|(k, _)| *k);
+        let steps = steps.into_iter().map(|(_, s)| s).collect();
+
+        Ok(Self {
+            name: topo.name.clone(),
+            ids,
+            index,
+            xyz0,
+            loads,
+            is_support,
+            is_origin,
+            sequence,
+            trail_u,
+            trail_v,
+            lengths,
+            planes,
+            dev_u,
+            dev_v,
+            forces,
+            direct,
+            trails,
+            steps,
+            adj_start,
+            adj_split,
+            adj,
+            has_indirect,
+            aux,
+            n_input_trail_edges,
+        })
+    }
+
+    /// Number of nodes including auxiliary nodes.
+    pub fn node_count(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// Node ids in model order (topology order, then auxiliary nodes).
+    pub fn node_ids(&self) -> &[NodeId] {
+        &self.ids
+    }
+
+    /// Model index of a node id.
+    pub fn node_index(&self, id: NodeId) -> Option<usize> {
+        self.index.get(&id).copied()
+    }
+
+    /// Sequence `k(n)` of every node, in model order.
+    pub fn sequences(&self) -> &[usize] {
+        &self.sequence
+    }
+
+    /// The trails as node-id lists from origin to support, in processing order.
+    pub fn trails(&self) -> Vec<Vec<NodeId>> {
+        self.trails
+            .iter()
+            .map(|t| t.nodes.iter().map(|&i| self.ids[i]).collect())
+            .collect()
+    }
+
+    /// `true` for each deviation edge (topology order) whose ends share a sequence.
+    pub fn direct_flags(&self) -> &[bool] {
+        &self.direct
+    }
+
+    /// Whether any deviation edge is indirect (the solve then iterates).
+    pub fn has_indirect_edges(&self) -> bool {
+        self.has_indirect
+    }
+
+    /// Auxiliary trails created: `(node, auxiliary support)` id pairs.
+    pub fn auxiliary_trails(&self) -> Vec<(NodeId, NodeId)> {
+        self.aux
+            .iter()
+            .map(|a| (self.ids[a.node], self.ids[a.aux]))
+            .collect()
+    }
+}

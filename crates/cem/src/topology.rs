@@ -1,0 +1,263 @@
+//! The topology diagram (cem.md §1): nodes with loads and roles, trail edges with signed
+//! lengths, deviation edges with signed forces, plus the options that change how trails are
+//! built (auxiliary trails, trail shifts).
+//!
+//! A [`Topology`] is plain data with public fields, so callers may build it directly, mutate
+//! lengths/forces between solves, or use the chaining [`TopologyBuilder`]. Nothing is
+//! validated here except by [`TopologyBuilder::build`]; every solve validates again through
+//! [`crate::Model::new`].
+//!
+//! Sign conventions: trail length `λ < 0` and deviation force `μ < 0` mean compression,
+//! positive means tension.
+
+use nalgebra::Vector3;
+
+use crate::error::CemError;
+
+/// A node id: any non-negative integer, unique within a topology.
+pub type NodeId = u64;
+
+/// A node of the topology diagram.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Unique id.
+    pub id: NodeId,
+    /// Coordinates. Only read for origin nodes (the prescribed positions); for every other
+    /// node it is a starting guess that the solver overwrites.
+    pub xyz: Vector3<f64>,
+    /// Point load (a force vector) applied to the node.
+    pub load: Vector3<f64>,
+    /// `true` if the node ends a trail. A support with no trail edge is a *reaction node*
+    /// (Kappe's extension, see [`crate::Model`]).
+    pub support: bool,
+    /// Optional check: if `Some`, must match the derived origin role.
+    pub origin: Option<bool>,
+}
+
+/// A plane given by a point and a normal (the normal need not be unit length).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// A point on the plane.
+    pub origin: Vector3<f64>,
+    /// The plane normal (normalized on use).
+    pub normal: Vector3<f64>,
+}
+
+/// A trail edge with its signed target length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrailEdge {
+    /// One end (orientation carries no meaning).
+    pub u: NodeId,
+    /// Other end.
+    pub v: NodeId,
+    /// Signed length λ: `< 0` compression, `> 0` tension.
+    pub length: f64,
+    /// Optional plane: the edge length becomes the signed distance along the residual from
+    /// the node to this plane (cem.md §4.4); `length` is the fallback when the ray is parallel.
+    pub plane: Option<Plane>,
+}
+
+/// A deviation edge with its signed force.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeviationEdge {
+    /// One end.
+    pub u: NodeId,
+    /// Other end.
+    pub v: NodeId,
+    /// Signed force μ: `< 0` compression, `> 0` tension.
+    pub force: f64,
+}
+
+/// Options of automatically generated auxiliary trails (cem.md §1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AuxiliaryTrails {
+    /// Signed length of every auxiliary trail edge (compas default −1).
+    pub length: f64,
+    /// Direction used only for the initial position of the auxiliary support (never the result).
+    pub vector: Vector3<f64>,
+}
+
+impl Default for AuxiliaryTrails {
+    fn default() -> Self {
+        Self {
+            length: -1.0,
+            vector: Vector3::new(1.0, 1.0, 1.0),
+        }
+    }
+}
+
+/// Shift of a trail: its nodes get sequences `start, start+1, …` (compas `shift_trail`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrailShift {
+    /// The origin node of the trail.
+    pub origin: NodeId,
+    /// Sequence of the origin.
+    pub start: usize,
+}
+
+/// A complete topology diagram. Node order matters: trails are processed in the order in
+/// which their supports appear in `nodes` (compas_cem's order, cem.md §2).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Topology {
+    /// Free-text name (copied to outputs).
+    pub name: String,
+    /// Nodes in insertion order.
+    pub nodes: Vec<Node>,
+    /// Trail edges.
+    pub trail_edges: Vec<TrailEdge>,
+    /// Deviation edges.
+    pub deviation_edges: Vec<DeviationEdge>,
+    /// `Some` to generate auxiliary trails for nodes that have no trail edge.
+    pub auxiliary_trails: Option<AuxiliaryTrails>,
+    /// Trail shifts, applied after the trails are built.
+    pub trail_shifts: Vec<TrailShift>,
+}
+
+impl Topology {
+    /// Start a [`TopologyBuilder`].
+    pub fn builder() -> TopologyBuilder {
+        TopologyBuilder::default()
+    }
+
+    /// Index of the node with this id in `nodes` (linear search; [`crate::Model`] keeps a map).
+    pub fn node_index(&self, id: NodeId) -> Option<usize> {
+        self.nodes.iter().position(|n| n.id == id)
+    }
+
+    /// Index of the trail edge joining `a` and `b` in either orientation.
+    pub fn trail_edge_index(&self, a: NodeId, b: NodeId) -> Option<usize> {
+        self.trail_edges
+            .iter()
+            .position(|e| (e.u == a && e.v == b) || (e.u == b && e.v == a))
+    }
+
+    /// Index of the deviation edge joining `a` and `b` in either orientation.
+    pub fn deviation_edge_index(&self, a: NodeId, b: NodeId) -> Option<usize> {
+        self.deviation_edges
+            .iter()
+            .position(|e| (e.u == a && e.v == b) || (e.u == b && e.v == a))
+    }
+}
+
+/// Chaining builder for a [`Topology`] in code.
+///
+/// ```
+/// use kappe_cem::{Topology, SolverOptions, solve};
+/// // Two one-edge compression trails joined by a compression deviation edge
+/// // (compas_cem's "threebar funicular").
+/// let topo = Topology::builder()
+///     .node(0, [0.0, 0.0, 0.0]).support(0)
+///     .node(1, [1.0, 0.0, 0.0]).load(1, [0.0, -1.0, 0.0])
+///     .node(2, [2.5, 0.0, 0.0]).load(2, [0.0, -1.0, 0.0])
+///     .node(3, [3.5, 0.0, 0.0]).support(3)
+///     .trail_edge(0, 1, -1.0)
+///     .trail_edge(2, 3, -1.0)
+///     .deviation_edge(1, 2, -1.0)
+///     .build()?;
+/// let eq = solve(&topo, &SolverOptions::default())?;
+/// let r = eq.reaction(0).unwrap();
+/// assert!((r - nalgebra::Vector3::new(1.0, 1.0, 0.0)).norm() < 1e-12);
+/// # Ok::<(), kappe_cem::CemError>(())
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct TopologyBuilder {
+    topo: Topology,
+    /// Id references to unknown nodes are recorded here and reported by `build`.
+    pending_error: Option<CemError>,
+}
+
+impl TopologyBuilder {
+    /// Set the name.
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.topo.name = name.into();
+        self
+    }
+
+    /// Add a plain node (no load, not a support).
+    pub fn node(mut self, id: NodeId, xyz: [f64; 3]) -> Self {
+        self.topo.nodes.push(Node {
+            id,
+            xyz: Vector3::from(xyz),
+            load: Vector3::zeros(),
+            support: false,
+            origin: None,
+        });
+        self
+    }
+
+    fn with_node(mut self, id: NodeId, what: &str, f: impl FnOnce(&mut Node)) -> Self {
+        // Last match: a duplicate id is reported by `build`, so which one we touch is moot.
+        match self.topo.nodes.iter_mut().rev().find(|n| n.id == id) {
+            Some(n) => f(n),
+            None => {
+                self.pending_error.get_or_insert(CemError::UnknownNode {
+                    id,
+                    context: format!("builder `{what}`"),
+                });
+            }
+        }
+        self
+    }
+
+    /// Add `q` to the load of node `id`.
+    pub fn load(self, id: NodeId, q: [f64; 3]) -> Self {
+        self.with_node(id, "load", |n| n.load += Vector3::from(q))
+    }
+
+    /// Mark node `id` as a support.
+    pub fn support(self, id: NodeId) -> Self {
+        self.with_node(id, "support", |n| n.support = true)
+    }
+
+    /// Add a trail edge with signed length λ.
+    pub fn trail_edge(mut self, u: NodeId, v: NodeId, length: f64) -> Self {
+        self.topo.trail_edges.push(TrailEdge {
+            u,
+            v,
+            length,
+            plane: None,
+        });
+        self
+    }
+
+    /// Add a trail edge whose length is cut by a plane (cem.md §4.4).
+    pub fn trail_edge_to_plane(mut self, u: NodeId, v: NodeId, length: f64, plane: Plane) -> Self {
+        self.topo.trail_edges.push(TrailEdge {
+            u,
+            v,
+            length,
+            plane: Some(plane),
+        });
+        self
+    }
+
+    /// Add a deviation edge with signed force μ.
+    pub fn deviation_edge(mut self, u: NodeId, v: NodeId, force: f64) -> Self {
+        self.topo
+            .deviation_edges
+            .push(DeviationEdge { u, v, force });
+        self
+    }
+
+    /// Enable auxiliary trails.
+    pub fn auxiliary_trails(mut self, aux: AuxiliaryTrails) -> Self {
+        self.topo.auxiliary_trails = Some(aux);
+        self
+    }
+
+    /// Shift the trail starting at `origin` to start at sequence `start`.
+    pub fn shift_trail(mut self, origin: NodeId, start: usize) -> Self {
+        self.topo.trail_shifts.push(TrailShift { origin, start });
+        self
+    }
+
+    /// Finish, checking ids, finiteness and edge endpoints (trail building is checked by
+    /// [`crate::Model::new`]).
+    pub fn build(self) -> Result<Topology, CemError> {
+        if let Some(e) = self.pending_error {
+            return Err(e);
+        }
+        crate::model::check_elements(&self.topo)?;
+        Ok(self.topo)
+    }
+}
