@@ -1,1 +1,20 @@
-//! (work in progress)
+//! # kappe: the 3D-printed cap ceiling
+//!
+//! The method of the paper (`cap-ceiling-paper.txt`) made precise in `method.md`:
+//! a design spec ([`Design`]) → the layer arch form-found with constrained CEM ([`arch`]) →
+//! the centre and start sections ([`section`]) → the network of every print state ([`states`]),
+//! its forces from CEM's fixed-geometry force pass → the print path ([`path`]) and the bead mesh
+//! ([`mesh`]).
+
+pub mod analysis;
+pub mod arch;
+pub mod error;
+pub mod frame;
+pub mod mesh;
+pub mod path;
+pub mod section;
+pub mod spec;
+pub mod states;
+
+pub use error::DesignError;
+pub use spec::Design;

@@ -1,0 +1,400 @@
+//! The design specification: every parameter and constraint of `method.md` §2–3, with defaults,
+//! read from TOML and validated field by field.
+//!
+//! Units are SI (m, N, Pa, s); angles are degrees in the file and radians in code.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::DesignError;
+
+/// A complete cap-ceiling design: geometry, material, printing, constraints, robot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Design {
+    /// A name for reports.
+    pub name: String,
+    /// Global geometry of the cap.
+    pub cap: CapSpec,
+    /// Material of the printed bead (green state).
+    pub material: MaterialSpec,
+    /// Bead and print-path settings.
+    pub print: PrintSpec,
+    /// Structural and fabrication limits.
+    pub constraints: ConstraintSpec,
+    /// Robot and tool settings (used by the motion planner).
+    pub robot: RobotSpec,
+}
+
+/// Global geometry (method.md §2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CapSpec {
+    /// Cs: clear span between the springing lines, m.
+    pub span: f64,
+    /// Cr: height of the crown above the base plane, m.
+    pub rise: f64,
+    /// Cl: length of the centre section along y, measured on the base plane, m.
+    pub length: f64,
+    /// am: tilt of every layer plane from the vertical, degrees.
+    pub tilt_deg: f64,
+}
+
+/// Material (method.md §2–3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MaterialSpec {
+    /// γ: specific weight of the green material, N/m³.
+    pub specific_weight: f64,
+    /// E: Young's modulus used for the buckling analysis, Pa.
+    pub youngs_modulus: f64,
+    /// ν: Poisson's ratio.
+    pub poisson_ratio: f64,
+}
+
+/// Bead and path (method.md §2, §7).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PrintSpec {
+    /// lh: spacing of consecutive layer planes along their normal, m.
+    pub layer_height: f64,
+    /// lw: bead width = shell thickness, m.
+    pub layer_width: f64,
+    /// d_n: nozzle diameter, m.
+    pub nozzle_diameter: f64,
+    /// Δs: target node spacing along a layer, m.
+    pub path_sampling: f64,
+    /// φ: share of the centre arch force that start layers keep in the final state, [0, 1).
+    pub start_arch_fraction: f64,
+    /// Nozzle speed along the path while printing, m/s.
+    pub print_speed: f64,
+}
+
+/// Constraints (method.md §3). Stresses are negative in compression.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ConstraintSpec {
+    /// σ_min: most negative allowed normal stress (compressive strength), Pa.
+    pub sigma_min: f64,
+    /// σ_max: largest allowed normal stress (tensile strength), Pa.
+    pub sigma_max: f64,
+    /// BLF_min: calibrated lower bound of the linear buckling load factor.
+    pub blf_min: f64,
+    /// l_o,max: largest allowed layer overhang, m. Default lw/2 (method.md §3).
+    pub overhang_max: Option<f64>,
+}
+
+/// Robot and tool settings for the motion planner (method.md §8, robot.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RobotSpec {
+    /// Plan the robot motion as part of `kappe design`.
+    pub enabled: bool,
+    /// Length of the straight nozzle from the flange to the tip, m.
+    pub tool_length: f64,
+    /// Compatibility threshold ε on Σ(Δq)² between consecutive configurations, rad².
+    pub epsilon: f64,
+    /// Rotation step about the tool axis, degrees.
+    pub rotation_step_deg: f64,
+    /// Planner: "optimal" (exact shortest path) or "random" (paper, seeded).
+    pub planner: String,
+    /// Seed of the random planner.
+    pub seed: u64,
+}
+
+impl Default for Design {
+    fn default() -> Self {
+        Design {
+            name: "default".into(),
+            cap: CapSpec::default(),
+            material: MaterialSpec::default(),
+            print: PrintSpec::default(),
+            constraints: ConstraintSpec::default(),
+            robot: RobotSpec::default(),
+        }
+    }
+}
+
+impl Default for CapSpec {
+    fn default() -> Self {
+        CapSpec {
+            span: 0.8,
+            rise: 0.2,
+            length: 0.6,
+            tilt_deg: 25.0,
+        }
+    }
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        MaterialSpec {
+            specific_weight: 23044.0,
+            youngs_modulus: 10.0e6,
+            poisson_ratio: 0.35,
+        }
+    }
+}
+
+impl Default for PrintSpec {
+    fn default() -> Self {
+        PrintSpec {
+            layer_height: 0.008,
+            layer_width: 0.020,
+            nozzle_diameter: 0.015,
+            path_sampling: 0.02,
+            start_arch_fraction: 0.0,
+            print_speed: 0.05,
+        }
+    }
+}
+
+impl Default for ConstraintSpec {
+    fn default() -> Self {
+        ConstraintSpec {
+            sigma_min: -20.0e3,
+            sigma_max: 0.0,
+            blf_min: 1.0,
+            overhang_max: None,
+        }
+    }
+}
+
+impl Default for RobotSpec {
+    fn default() -> Self {
+        RobotSpec {
+            enabled: true,
+            tool_length: 0.20,
+            epsilon: 0.05,
+            rotation_step_deg: 10.0,
+            planner: "optimal".into(),
+            seed: 1,
+        }
+    }
+}
+
+/// The embedded default design file, with comments (what `kappe init` writes).
+pub const EXAMPLE_TOML: &str = include_str!("default_design.toml");
+
+impl Design {
+    /// Parse a design from TOML; every missing field takes its default. Unknown fields are errors.
+    ///
+    /// ```
+    /// let d = kappe::Design::from_toml_str("[cap]\nspan = 1.0\n").unwrap();
+    /// assert_eq!(d.cap.span, 1.0);
+    /// assert_eq!(d.cap.rise, 0.2);
+    /// ```
+    pub fn from_toml_str(text: &str) -> Result<Design, DesignError> {
+        let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
+            path: String::new(),
+            message: e.to_string().trim().to_string(),
+        })?;
+        let design: Design = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            DesignError::Parse {
+                path,
+                message: inner.message().trim().to_string(),
+            }
+        })?;
+        design.validate()?;
+        Ok(design)
+    }
+
+    /// Serialize to TOML (the resolved design, every field explicit).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Layer tilt am in radians.
+    pub fn tilt(&self) -> f64 {
+        self.cap.tilt_deg.to_radians()
+    }
+
+    /// l_o,max, defaulting to lw/2 (method.md §3).
+    pub fn overhang_max(&self) -> f64 {
+        self.constraints
+            .overhang_max
+            .unwrap_or(0.5 * self.print.layer_width)
+    }
+
+    /// Check every field against its allowed range (method.md §2–3).
+    pub fn validate(&self) -> Result<(), DesignError> {
+        fn check(
+            field: &'static str,
+            value: f64,
+            ok: bool,
+            allowed: impl Into<String>,
+        ) -> Result<(), DesignError> {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(DesignError::Invalid {
+                    field,
+                    value: format!("{value}"),
+                    allowed: allowed.into(),
+                })
+            }
+        }
+        let c = &self.cap;
+        let p = &self.print;
+        let m = &self.material;
+        let k = &self.constraints;
+        check(
+            "cap.span",
+            c.span,
+            c.span > 0.05 && c.span <= 20.0,
+            "allowed: 0.05 m < span ≤ 20 m",
+        )?;
+        check("cap.rise", c.rise, c.rise > 0.0, "allowed: rise > 0 m")?;
+        let ratio = c.rise / c.span;
+        check(
+            "cap.rise",
+            c.rise,
+            (0.05..=1.0).contains(&ratio),
+            format!(
+                "rise/span = {ratio:.3}; a compression arch of this method needs 0.05 ≤ rise/span ≤ 1 \
+                 (flatter arches have unbounded thrust, steeper ones are not caps)"
+            ),
+        )?;
+        check(
+            "cap.length",
+            c.length,
+            c.length > 0.0 && c.length <= 50.0,
+            "allowed: 0 < length ≤ 50 m",
+        )?;
+        check(
+            "cap.tilt_deg",
+            c.tilt_deg,
+            c.tilt_deg > 0.0 && c.tilt_deg <= 60.0,
+            "allowed: 0° < tilt ≤ 60° (layer plane from the vertical)",
+        )?;
+        check(
+            "material.specific_weight",
+            m.specific_weight,
+            m.specific_weight > 0.0,
+            "allowed: specific weight > 0 N/m³",
+        )?;
+        check(
+            "material.youngs_modulus",
+            m.youngs_modulus,
+            m.youngs_modulus > 0.0,
+            "allowed: E > 0 Pa",
+        )?;
+        check(
+            "material.poisson_ratio",
+            m.poisson_ratio,
+            (0.0..0.5).contains(&m.poisson_ratio),
+            "allowed: 0 ≤ ν < 0.5",
+        )?;
+        check(
+            "print.nozzle_diameter",
+            p.nozzle_diameter,
+            p.nozzle_diameter > 0.0,
+            "allowed: > 0 m",
+        )?;
+        let dn = p.nozzle_diameter;
+        check(
+            "print.layer_height",
+            p.layer_height,
+            p.layer_height >= 0.4 * dn - 1e-12 && p.layer_height <= dn + 1e-12,
+            format!(
+                "allowed: 0.4·d_n ≤ layer height ≤ d_n, i.e. [{:.4}, {:.4}] m for this nozzle",
+                0.4 * dn,
+                dn
+            ),
+        )?;
+        check(
+            "print.layer_width",
+            p.layer_width,
+            p.layer_width >= dn - 1e-12 && p.layer_width <= 2.0 * dn + 1e-12,
+            format!(
+                "allowed: d_n ≤ layer width ≤ 2·d_n, i.e. [{:.4}, {:.4}] m for this nozzle",
+                dn,
+                2.0 * dn
+            ),
+        )?;
+        check(
+            "print.path_sampling",
+            p.path_sampling,
+            p.path_sampling > 0.0 && p.path_sampling <= c.span / 8.0,
+            format!(
+                "allowed: 0 < Δs ≤ span/8 = {:.4} m (at least 8 segments per arch)",
+                c.span / 8.0
+            ),
+        )?;
+        check(
+            "print.start_arch_fraction",
+            p.start_arch_fraction,
+            (0.0..1.0).contains(&p.start_arch_fraction),
+            "allowed: 0 ≤ φ < 1",
+        )?;
+        check(
+            "print.print_speed",
+            p.print_speed,
+            p.print_speed > 0.0 && p.print_speed <= 1.0,
+            "allowed: 0 < speed ≤ 1 m/s",
+        )?;
+        let n_layers = c.length * self.tilt().cos() / p.layer_height;
+        check(
+            "cap.length",
+            c.length,
+            n_layers >= 1.0 && n_layers <= 5000.0,
+            format!(
+                "gives {n_layers:.1} centre layers; allowed 1 to 5000 (length·cos(tilt)/layer height)"
+            ),
+        )?;
+        check(
+            "constraints.sigma_min",
+            k.sigma_min,
+            k.sigma_min < 0.0,
+            "allowed: σ_min < 0 Pa (compression is negative)",
+        )?;
+        check(
+            "constraints.sigma_max",
+            k.sigma_max,
+            k.sigma_max >= 0.0,
+            "allowed: σ_max ≥ 0 Pa",
+        )?;
+        check(
+            "constraints.blf_min",
+            k.blf_min,
+            k.blf_min > 0.0,
+            "allowed: BLF_min > 0",
+        )?;
+        if let Some(lo) = k.overhang_max {
+            check(
+                "constraints.overhang_max",
+                lo,
+                lo > 0.0,
+                "allowed: l_o,max > 0 m",
+            )?;
+        }
+        let r = &self.robot;
+        check(
+            "robot.tool_length",
+            r.tool_length,
+            r.tool_length > 0.0 && r.tool_length <= 1.0,
+            "allowed: 0 < tool length ≤ 1 m",
+        )?;
+        check(
+            "robot.epsilon",
+            r.epsilon,
+            r.epsilon > 0.0,
+            "allowed: ε > 0 rad²",
+        )?;
+        check(
+            "robot.rotation_step_deg",
+            r.rotation_step_deg,
+            r.rotation_step_deg > 0.0 && r.rotation_step_deg <= 180.0,
+            "allowed: 0° < step ≤ 180°",
+        )?;
+        if r.planner != "optimal" && r.planner != "random" {
+            return Err(DesignError::Invalid {
+                field: "robot.planner",
+                value: format!("{:?}", r.planner),
+                allowed: "allowed: \"optimal\" or \"random\"".into(),
+            });
+        }
+        Ok(())
+    }
+}
