@@ -4,8 +4,11 @@
 //! Frames follow the rerun naming `a_from_b` ([`frames`]). The base frame is the UR DH base
 //! (controller Base), the flange is DH frame 6, a TCP pose is `base_from_flange · flange_from_tcp`.
 
+pub mod collision;
+pub mod error;
 pub mod frames;
 pub mod kinematics;
 
+pub use error::{FailureKind, PlanFailure, RobotError};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
