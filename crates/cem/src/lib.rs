@@ -41,6 +41,8 @@
 
 pub mod equilibrium;
 pub mod error;
+pub mod example;
+pub mod fixed_geometry;
 pub mod json;
 pub mod model;
 pub mod topology;
@@ -50,6 +52,7 @@ pub use equilibrium::{
     Scalar, SolverOptions, TrailEdgeResult, solve,
 };
 pub use error::CemError;
+pub use fixed_geometry::{ForcePass, force_pass};
 pub use model::Model;
 pub use topology::{
     AuxiliaryTrails, DeviationEdge, Node, NodeId, Plane, Topology, TopologyBuilder, TrailEdge,
