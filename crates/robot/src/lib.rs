@@ -8,6 +8,7 @@ pub mod collision;
 pub mod error;
 pub mod frames;
 pub mod kinematics;
+pub mod ladder;
 
 pub use error::{FailureKind, PlanFailure, RobotError};
 pub use frames::{Iso, Mat4};

@@ -4,3 +4,4 @@
 mod collision;
 mod common;
 mod kinematics;
+mod ladder;
