@@ -1,0 +1,240 @@
+//! Sparse factorizations on the shared pattern (faer low-level API): one symbolic analysis
+//! (AMD ordering, supernodal or simplicial by flop count), then numeric LLᵀ of K and LDLᵀ of
+//! `K + σ K_G` for the Sturm count. The symbolic part is what [`crate::BucklingSolver`] caches.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{
+    LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+    factorize_symbolic_cholesky,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, MatMut, Par, Side};
+
+use crate::assembly::Pattern;
+use crate::error::FeError;
+
+/// Symbolic Cholesky of a pattern.
+#[derive(Debug)]
+pub(crate) struct Symbolic {
+    pub(crate) pattern_mat: SymbolicSparseColMat<usize>,
+    pub(crate) chol: SymbolicCholesky<usize>,
+}
+
+/// Why a numeric LLᵀ failed.
+pub(crate) enum LltFailure {
+    /// Non-positive pivot at this (original, un-permuted) free-DOF index.
+    NotPositive(Option<usize>),
+    /// Anything else.
+    Other(FeError),
+}
+
+fn par() -> Par {
+    Par::rayon(0)
+}
+
+impl Symbolic {
+    pub(crate) fn new(p: &Pattern) -> Result<Self, FeError> {
+        let pattern_mat =
+            SymbolicSparseColMat::new_checked(p.n, p.n, p.col_ptr.clone(), None, p.row_idx.clone());
+        let chol = factorize_symbolic_cholesky(
+            pattern_mat.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            Default::default(),
+        )
+        .map_err(|e| FeError::Numerical {
+            stage: "symbolic Cholesky",
+            detail: format!("{e:?}"),
+        })?;
+        Ok(Self { pattern_mat, chol })
+    }
+
+    /// Number of stored entries of the factor L.
+    pub(crate) fn nnz_l(&self) -> usize {
+        self.chol.len_val()
+    }
+
+    fn mat<'a>(&'a self, vals: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+        SparseColMatRef::new(self.pattern_mat.as_ref(), vals)
+    }
+
+    /// Numeric LLᵀ of the matrix with lower values `vals`.
+    pub(crate) fn llt(&self, vals: &[f64]) -> Result<Llt<'_>, LltFailure> {
+        let mut l = Vec::new();
+        l.try_reserve_exact(self.chol.len_val()).map_err(|_| {
+            LltFailure::Other(FeError::Numerical {
+                stage: "Cholesky",
+                detail: "out of memory for the factor".into(),
+            })
+        })?;
+        l.resize(self.chol.len_val(), 0.0);
+        let req = self
+            .chol
+            .factorize_numeric_llt_scratch::<f64>(par(), Default::default());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| {
+            LltFailure::Other(FeError::Numerical {
+                stage: "Cholesky",
+                detail: "out of memory for the workspace".into(),
+            })
+        })?;
+        let res = self.chol.factorize_numeric_llt::<f64>(
+            &mut l,
+            self.mat(vals),
+            Side::Lower,
+            Default::default(),
+            par(),
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        match res {
+            Ok(_) => Ok(Llt { sym: self, l }),
+            Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => {
+                let orig = match self.chol.perm() {
+                    Some(p) => p.arrays().0.get(index).copied(),
+                    None => Some(index),
+                };
+                Err(LltFailure::NotPositive(orig))
+            }
+        }
+    }
+
+    /// Number of negative pivots of an LDLᵀ factorization (no pivoting) of the symmetric
+    /// matrix with lower values `vals`. By Sylvester's law of inertia this is the number of
+    /// negative eigenvalues. Returns `None` on a zero pivot (caller perturbs the shift).
+    pub(crate) fn negative_pivots(&self, vals: &[f64]) -> Result<Option<usize>, FeError> {
+        let oom = |what: &str| FeError::Numerical {
+            stage: "LDLᵀ (Sturm check)",
+            detail: format!("out of memory for the {what}"),
+        };
+        let mut l = Vec::new();
+        l.try_reserve_exact(self.chol.len_val())
+            .map_err(|_| oom("factor"))?;
+        l.resize(self.chol.len_val(), 0.0);
+        let req = self
+            .chol
+            .factorize_numeric_ldlt_scratch::<f64>(par(), Default::default());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| oom("workspace"))?;
+        let res = self.chol.factorize_numeric_ldlt::<f64>(
+            &mut l,
+            self.mat(vals),
+            Side::Lower,
+            Default::default(),
+            par(),
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        let ldlt: LdltRef<'_, usize, f64> = match res {
+            Ok(f) => f,
+            Err(_) => return Ok(None),
+        };
+        let _ = ldlt;
+        // D sits on the diagonal of L (unit lower triangular otherwise).
+        let mut neg = 0;
+        match self.chol.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let cp = s.col_ptr();
+                let ri = s.row_idx();
+                for j in 0..s.nrows() {
+                    for p in cp[j]..cp[j + 1] {
+                        if ri[p] == j {
+                            let d = l[p];
+                            if d == 0.0 || !d.is_finite() {
+                                return Ok(None);
+                            }
+                            if d < 0.0 {
+                                neg += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let f = faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef::new(s, &l);
+                for k in 0..s.n_supernodes() {
+                    let sn = f.supernode(k);
+                    let v = sn.val();
+                    for i in 0..v.ncols() {
+                        let d = v[(i, i)];
+                        if d == 0.0 || !d.is_finite() {
+                            return Ok(None);
+                        }
+                        if d < 0.0 {
+                            neg += 1;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(Some(neg))
+    }
+}
+
+/// Numeric LLᵀ factor of K.
+pub(crate) struct Llt<'a> {
+    sym: &'a Symbolic,
+    l: Vec<f64>,
+}
+
+impl Llt<'_> {
+    /// Smallest ratio `L_ii² / A_ii` over the pivots, and the original free-DOF index where
+    /// it occurs. For an SPD stiffness this is the fraction of a DOF's own stiffness left
+    /// after eliminating its predecessors; ~1e-16 means a (numerically) singular matrix that
+    /// LLᵀ happened to push through with round-off-sized pivots.
+    pub(crate) fn min_pivot_ratio(&self, a_diag: &[f64]) -> (f64, usize) {
+        let fwd: Option<&[usize]> = self.sym.chol.perm().map(|p| p.arrays().0);
+        let orig = |i: usize| fwd.and_then(|f| f.get(i).copied()).unwrap_or(i);
+        let mut best = (f64::INFINITY, 0usize);
+        let mut visit = |i: usize, lii: f64| {
+            let o = orig(i);
+            let d = a_diag.get(o).copied().unwrap_or(1.0);
+            let r = lii * lii / d;
+            if r < best.0 {
+                best = (r, o);
+            }
+        };
+        match self.sym.chol.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let cp = s.col_ptr();
+                let ri = s.row_idx();
+                for j in 0..s.nrows() {
+                    for p in cp[j]..cp[j + 1] {
+                        if ri[p] == j {
+                            visit(j, self.l[p]);
+                        }
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let f =
+                    faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef::new(s, &self.l);
+                for k in 0..s.n_supernodes() {
+                    let sn = f.supernode(k);
+                    let v = sn.val();
+                    for i in 0..v.ncols() {
+                        visit(sn.start() + i, v[(i, i)]);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Solve `K X = B` in place for all columns of `rhs`.
+    pub(crate) fn solve_in_place(&self, rhs: MatMut<'_, f64>) -> Result<(), FeError> {
+        let req = self
+            .sym
+            .chol
+            .solve_in_place_scratch::<f64>(rhs.ncols(), par());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| FeError::Numerical {
+            stage: "solve",
+            detail: "out of memory for the workspace".into(),
+        })?;
+        LltRef::<'_, usize, f64>::new(&self.sym.chol, &self.l).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            par(),
+            MemStack::new(&mut buf),
+        );
+        Ok(())
+    }
+}
