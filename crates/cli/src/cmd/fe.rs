@@ -1,18 +1,168 @@
-//! `kappe fe ...` (being built).
+//! `kappe fe ...`: linear buckling and linear statics of a shell mesh (the fixture mesh format
+//! of `../shared/fixtures/fe/`, see `kappe_fe::mesh_json`).
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
-use anyhow::{Result, bail};
-use clap::Subcommand;
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand};
+use kappe_fe::mesh_json::parse_mesh;
+use kappe_fe::{BucklingOptions, BucklingSolver, ShellModel, StaticResult};
+use serde_json::{Value, json};
+
+use crate::output::write_file_atomic;
 
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Not available yet.
-    Todo,
+    /// Linear buckling: lowest positive load factors of (K + λ K_G) φ = 0 under the mesh's load.
+    Buckle(BuckleArgs),
+    /// Linear statics: displacements, reactions, membrane forces, moments and stresses.
+    Static(StaticArgs),
+}
+
+#[derive(Args)]
+pub struct BuckleArgs {
+    /// Input mesh (JSON, fixture mesh format).
+    mesh: PathBuf,
+    /// Output file (written atomically); stdout when absent.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Number of buckling factors (lowest positive).
+    #[arg(long, default_value_t = 3)]
+    modes: usize,
+    /// Include the mode shapes (per node [ux, uy, uz, rx, ry, rz], max |·| = 1).
+    #[arg(long)]
+    mode_shapes: bool,
+    /// Skip the Sturm-count check (saves one factorization).
+    #[arg(long)]
+    no_sturm: bool,
+}
+
+#[derive(Args)]
+pub struct StaticArgs {
+    /// Input mesh (JSON, fixture mesh format).
+    mesh: PathBuf,
+    /// Output file (written atomically); stdout when absent.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
 }
 
 pub fn run(cmd: FeCommand) -> Result<ExitCode> {
     match cmd {
-        FeCommand::Todo => bail!("`kappe fe` is not available yet"),
+        FeCommand::Buckle(a) => buckle(a),
+        FeCommand::Static(a) => statics(a),
     }
+}
+
+fn load(path: &Path) -> Result<ShellModel> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))
+}
+
+fn emit(output: Option<&Path>, doc: &Value) -> Result<()> {
+    let mut text = serde_json::to_string_pretty(doc).context("cannot serialize the result")?;
+    text.push('\n');
+    match output {
+        Some(out) => write_file_atomic(out, text.as_bytes()),
+        None => {
+            print!("{text}");
+            Ok(())
+        }
+    }
+}
+
+fn static_summary(s: &StaticResult) -> Value {
+    json!({
+        "max_displacement": s.max_displacement,
+        "reactions_sum": s.reactions_sum,
+        "load_sum": s.load_sum,
+    })
+}
+
+fn buckle(args: BuckleArgs) -> Result<ExitCode> {
+    let t0 = Instant::now();
+    let model = load(&args.mesh)?;
+    let source = args.mesh.display().to_string();
+    let options = BucklingOptions {
+        modes: args.modes,
+        sturm_check: !args.no_sturm,
+        ..BucklingOptions::default()
+    };
+    let solver = BucklingSolver::new(&model).with_context(|| format!("invalid model {source}"))?;
+    let r = solver
+        .buckling(&model, &options)
+        .with_context(|| format!("buckling analysis of {source} failed"))?;
+    let time_s = t0.elapsed().as_secs_f64();
+    let s = &r.stats;
+    let mut doc = json!({
+        "factors": r.factors,
+        "static": static_summary(&r.static_result),
+        "dofs": s.n_free_dofs,
+        "time_s": time_s,
+        "residuals": r.residuals,
+        "sturm": r.sturm.map(|c| json!({
+            "sigma": c.sigma,
+            "negative_pivots": c.negative_pivots,
+            "factors_below_sigma": c.found_below,
+        })),
+        "solver": {
+            "element": "CST + DKT + drilling (alpha = model drilling_alpha)",
+            "nnz_k": s.nnz_k,
+            "nnz_l": s.nnz_l,
+            "operator_applications": s.operator_applications,
+            "t_symbolic_s": s.t_symbolic,
+            "t_assembly_s": s.t_assembly,
+            "t_factor_s": s.t_factor,
+            "t_geometric_s": s.t_geometric,
+            "t_eigen_s": s.t_eigen,
+            "t_sturm_s": s.t_sturm,
+        },
+    });
+    if args.mode_shapes {
+        doc["modes"] = json!(r.modes);
+    }
+    emit(args.output.as_deref(), &doc)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn statics(args: StaticArgs) -> Result<ExitCode> {
+    let t0 = Instant::now();
+    let model = load(&args.mesh)?;
+    let source = args.mesh.display().to_string();
+    let r = kappe_fe::linear_static(&model)
+        .with_context(|| format!("static analysis of {source} failed"))?;
+    let elements: Vec<Value> = r
+        .elements
+        .iter()
+        .map(|e| {
+            json!({
+                "frame": e.frame,
+                "membrane_force": e.resultants.membrane,
+                "moment": e.resultants.moment,
+                "membrane_stress": e.membrane_stress(),
+                "stress_top": e.surface_stress(true),
+                "stress_bottom": e.surface_stress(false),
+            })
+        })
+        .collect();
+    let reactions: Vec<Value> = r
+        .reactions
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.iter().any(|v| *v != 0.0))
+        .map(|(n, f)| json!({"node": n, "reaction": f}))
+        .collect();
+    let doc = json!({
+        "static": static_summary(&r),
+        "dofs": r.n_free_dofs,
+        "time_s": t0.elapsed().as_secs_f64(),
+        "displacements": r.displacements,
+        "reactions": reactions,
+        "elements": elements,
+        "element_note": "per element, local frame rows [e1, e2, e3]; membrane_force [Nx, Ny, Nxy] N/m (tension +); moment [Mx, My, Mxy] N·m/m at the centroid; stresses Pa, top = +e3 side",
+    });
+    emit(args.output.as_deref(), &doc)?;
+    Ok(ExitCode::SUCCESS)
 }
