@@ -1,0 +1,446 @@
+//! The plain-data input of the report.
+//!
+//! [`ReportInput`] is everything the report shows, in world coordinates and SI units (m, Pa, s,
+//! rad), with no dependency on the pipeline crates: the CLI fills it from the design, the
+//! analysis and the robot plan. It is serialised verbatim as the JSON scene island of
+//! `report.html` (`<script type="application/json" id="kappe-data">`), which the hand-written
+//! viewer (`assets/viewer.js`) reads; the field names below are therefore also the viewer's
+//! data format.
+//!
+//! Conventions (see `shared/reference/method.md` §1, §3, §7):
+//! - world frame: x across the span, y along the cap (printing advances toward +y), z up;
+//! - normal stress σ is signed, **compression negative**;
+//! - `layers` are listed **in print order** (start layers −K..−1, then 0..N−1); a print state
+//!   shows the first [`PrintState::layers_printed`] of them.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::ReportError;
+
+/// A point or vector in world coordinates (m for points).
+pub type Vec3 = [f64; 3];
+
+/// Everything the report shows. See the module docs for units and conventions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReportInput {
+    /// Design name, shown as the page title.
+    pub name: String,
+    /// Design parameters, shown as a table in the given order.
+    pub parameters: Vec<Parameter>,
+    /// Print layers in print order.
+    pub layers: Vec<Layer>,
+    /// Bed-joint edges between consecutive layers (the trail edges of method.md §5).
+    pub bed_joints: Vec<BedJoint>,
+    /// The nozzle path.
+    pub print_path: PrintPath,
+    /// Print states in print order (after each printed layer, or a coarser step).
+    pub states: Vec<PrintState>,
+    /// Constraint results (worst over all states), shown as a table, failures highlighted.
+    pub constraints: Vec<ConstraintRow>,
+    /// The robot moving along its trajectory, drawn as capsules.
+    pub robot: Option<RobotAnimation>,
+    /// Extra plots shown after the standard ones (which are derived from the fields above).
+    pub plots: Vec<Plot>,
+}
+
+/// One row of the parameters table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Parameter {
+    /// Symbol or key, e.g. `span`.
+    pub key: String,
+    /// Value as the user should read it (already formatted, e.g. `0.8` or `25`).
+    pub value: String,
+    /// Unit, e.g. `m`, `deg`, `N/m³`; empty when dimensionless.
+    pub unit: String,
+}
+
+/// One print layer: a closed arch whose bead centre line runs through `nodes`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Layer {
+    /// Layer id: negative for start layers (−K..−1), 0..N−1 for centre layers.
+    pub id: i32,
+    /// Bead centre line, from one foot over the crown to the other (at least 2 nodes), m.
+    pub nodes: Vec<Vec3>,
+    /// Normal stress of each segment `nodes[i]..nodes[i+1]` in the final state, Pa
+    /// (compression negative); `nodes.len() − 1` values.
+    pub segment_stress: Vec<f64>,
+    /// Unit normal of the layer plane, pointing from the printed part to the new layer
+    /// (method.md §4: n = (0, cos am, sin am)); the bead height is measured along it.
+    pub plane_normal: Vec3,
+    /// Bead width (shell thickness, in the layer plane across the path), m.
+    pub bead_width: f64,
+    /// Bead height (layer height, along `plane_normal`), m.
+    pub bead_height: f64,
+    /// Overhang of this layer over the preceding one (method.md §3), m; `None` for the first.
+    pub overhang: Option<f64>,
+}
+
+/// A bed-joint edge between two layers.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BedJoint {
+    /// Id of the upper layer: the joint exists from the state in which that layer is printed.
+    pub layer: i32,
+    /// End on the lower layer, m.
+    pub a: Vec3,
+    /// End on the upper layer, m.
+    pub b: Vec3,
+    /// Normal stress in the final state, Pa (compression negative).
+    pub stress: f64,
+}
+
+/// The nozzle path, struct-of-arrays: `points[i]`, `tool_axis[i]` and `layer[i]` belong together.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct PrintPath {
+    /// Nozzle tip positions in print order, m.
+    pub points: Vec<Vec3>,
+    /// Unit tool axis at each point (method.md §7: along −n, into the preceding layer).
+    pub tool_axis: Vec<Vec3>,
+    /// Id of the layer each point prints.
+    pub layer: Vec<i32>,
+}
+
+/// One print state: the structure after `layers_printed` layers (in print order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PrintState {
+    /// State index (as the pipeline numbers it; shown to the user).
+    pub index: usize,
+    /// Print progress Pp = printed / total, in [0, 1].
+    pub progress: f64,
+    /// How many layers, in print order, are printed in this state (≥ 1, ≤ `layers.len()`).
+    pub layers_printed: usize,
+    /// Lowest positive linear buckling load factor, if it was computed for this state.
+    pub blf: Option<f64>,
+    /// Most compressive normal stress σ_min over all elements, Pa (compression negative).
+    pub sigma_min: f64,
+    /// Largest normal stress σ_max over all elements, Pa (> 0 is tension).
+    pub sigma_max: f64,
+    /// Largest layer overhang among the printed layers, m.
+    pub max_overhang: f64,
+    /// Whether this state meets every structural constraint.
+    pub ok: bool,
+    /// Optional per-state stresses of the printed layers' segments, Pa: the segments of the
+    /// first `layers_printed` layers concatenated in print order. When absent the viewer
+    /// colours by the final-state [`Layer::segment_stress`].
+    pub segment_stress: Option<Vec<f64>>,
+}
+
+/// Whether a constraint bounds the value from above (`value ≤ limit`) or below (`value ≥ limit`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Bound {
+    /// `value ≤ limit`.
+    AtMost,
+    /// `value ≥ limit`.
+    AtLeast,
+}
+
+impl Bound {
+    /// The relation as a symbol for tables.
+    #[must_use]
+    pub fn symbol(self) -> &'static str {
+        match self {
+            Bound::AtMost => "≤",
+            Bound::AtLeast => "≥",
+        }
+    }
+}
+
+/// One row of the constraint table: the worst value of a constraint over all states.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintRow {
+    /// Constraint name, e.g. `sigma_min`, `blf`, `overhang`, `reach`.
+    pub name: String,
+    /// Direction of the bound.
+    pub bound: Bound,
+    /// The limit, in `unit`.
+    pub limit: f64,
+    /// The worst value found, in `unit`.
+    pub worst: f64,
+    /// Unit of `limit` and `worst` (e.g. `kPa`, `mm`, `""`).
+    pub unit: String,
+    /// Index of the state where the worst value occurs, if state-dependent.
+    pub state: Option<usize>,
+    /// Element (edge, node, layer, frame) where the worst value occurs, as text.
+    pub element: Option<String>,
+    /// Whether the constraint holds.
+    pub pass: bool,
+}
+
+/// The robot moving along its trajectory, for the viewer and the joint-angle plot.
+///
+/// The CLI computes the link segments with forward kinematics; the viewer draws link `j` at
+/// time step `i` as a cylinder of radius `link_radii[j]` from `poses[i][j][0]` to
+/// `poses[i][j][1]`, with a sphere at each end (a capsule).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotAnimation {
+    /// Time of each step, s, non-decreasing.
+    pub times: Vec<f64>,
+    /// Joint values q1..q6 at each step, rad.
+    pub joints: Vec<[f64; 6]>,
+    /// Radius of each link capsule, m.
+    pub link_radii: Vec<f64>,
+    /// Per time step, the world end points of each link segment, m: `link_radii.len()` per step.
+    pub poses: Vec<Vec<[Vec3; 2]>>,
+}
+
+/// A line plot rendered as inline SVG.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plot {
+    /// Title above the plot.
+    pub title: String,
+    /// x axis label (with unit).
+    pub x_label: String,
+    /// y axis label (with unit).
+    pub y_label: String,
+    /// The curves.
+    pub series: Vec<Series>,
+}
+
+/// One curve of a [`Plot`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Series {
+    /// Legend name.
+    pub name: String,
+    /// Points (x, y) in drawing order.
+    pub points: Vec<[f64; 2]>,
+}
+
+fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), ReportError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ReportError::NotFinite {
+            field: field(),
+            value,
+        })
+    }
+}
+
+fn finite3(field: impl Fn() -> String, v: &Vec3) -> Result<(), ReportError> {
+    for (k, c) in v.iter().enumerate() {
+        finite(|| format!("{}[{k}]", field()), *c)?;
+    }
+    Ok(())
+}
+
+fn mismatch(field: String, len: usize, expected: usize) -> ReportError {
+    ReportError::LengthMismatch {
+        field,
+        len,
+        expected,
+    }
+}
+
+impl ReportInput {
+    /// Checks everything the viewer and the plots rely on: every number finite (JSON has no
+    /// NaN), array lengths consistent, states referring to existing layers.
+    ///
+    /// # Errors
+    /// The first violation found, naming the field, its value and what is allowed.
+    pub fn validate(&self) -> Result<(), ReportError> {
+        if self.layers.is_empty() {
+            return Err(ReportError::Empty {
+                field: "layers".into(),
+            });
+        }
+        if self.states.is_empty() {
+            return Err(ReportError::Empty {
+                field: "states".into(),
+            });
+        }
+        for (li, layer) in self.layers.iter().enumerate() {
+            if layer.nodes.len() < 2 {
+                return Err(ReportError::TooFewNodes {
+                    layer: layer.id,
+                    len: layer.nodes.len(),
+                });
+            }
+            if layer.segment_stress.len() + 1 != layer.nodes.len() {
+                return Err(mismatch(
+                    format!("layers[{li}].segment_stress"),
+                    layer.segment_stress.len(),
+                    layer.nodes.len() - 1,
+                ));
+            }
+            for (ni, p) in layer.nodes.iter().enumerate() {
+                finite3(|| format!("layers[{li}].nodes[{ni}]"), p)?;
+            }
+            for (si, s) in layer.segment_stress.iter().enumerate() {
+                finite(|| format!("layers[{li}].segment_stress[{si}]"), *s)?;
+            }
+            finite3(|| format!("layers[{li}].plane_normal"), &layer.plane_normal)?;
+            for (name, v) in [
+                ("bead_width", layer.bead_width),
+                ("bead_height", layer.bead_height),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(ReportError::OutOfRange {
+                        field: format!("layers[{li}].{name}"),
+                        value: v,
+                        allowed: "a finite length > 0 m",
+                    });
+                }
+            }
+            if let Some(o) = layer.overhang {
+                finite(|| format!("layers[{li}].overhang"), o)?;
+            }
+        }
+        let has_layer = |id: i32| self.layers.iter().any(|l| l.id == id);
+        for (bi, joint) in self.bed_joints.iter().enumerate() {
+            if !has_layer(joint.layer) {
+                return Err(ReportError::UnknownLayer {
+                    field: format!("bed_joints[{bi}].layer"),
+                    id: joint.layer,
+                });
+            }
+            finite3(|| format!("bed_joints[{bi}].a"), &joint.a)?;
+            finite3(|| format!("bed_joints[{bi}].b"), &joint.b)?;
+            finite(|| format!("bed_joints[{bi}].stress"), joint.stress)?;
+        }
+        self.validate_path(&has_layer)?;
+        self.validate_states()?;
+        for (ci, c) in self.constraints.iter().enumerate() {
+            finite(|| format!("constraints[{ci}].limit"), c.limit)?;
+            finite(|| format!("constraints[{ci}].worst"), c.worst)?;
+        }
+        if let Some(robot) = &self.robot {
+            robot.validate()?;
+        }
+        for (pi, plot) in self.plots.iter().enumerate() {
+            for (si, s) in plot.series.iter().enumerate() {
+                for (k, xy) in s.points.iter().enumerate() {
+                    for (c, v) in xy.iter().enumerate() {
+                        finite(|| format!("plots[{pi}].series[{si}].points[{k}][{c}]"), *v)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_path(&self, has_layer: &dyn Fn(i32) -> bool) -> Result<(), ReportError> {
+        let path = &self.print_path;
+        let n = path.points.len();
+        if path.tool_axis.len() != n {
+            return Err(mismatch(
+                "print_path.tool_axis".into(),
+                path.tool_axis.len(),
+                n,
+            ));
+        }
+        if path.layer.len() != n {
+            return Err(mismatch("print_path.layer".into(), path.layer.len(), n));
+        }
+        for i in 0..n {
+            if let (Some(p), Some(a), Some(&l)) =
+                (path.points.get(i), path.tool_axis.get(i), path.layer.get(i))
+            {
+                finite3(|| format!("print_path.points[{i}]"), p)?;
+                finite3(|| format!("print_path.tool_axis[{i}]"), a)?;
+                if !has_layer(l) {
+                    return Err(ReportError::UnknownLayer {
+                        field: format!("print_path.layer[{i}]"),
+                        id: l,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_states(&self) -> Result<(), ReportError> {
+        for (si, s) in self.states.iter().enumerate() {
+            if s.layers_printed == 0 || s.layers_printed > self.layers.len() {
+                return Err(ReportError::OutOfRange {
+                    field: format!("states[{si}].layers_printed"),
+                    value: s.layers_printed as f64,
+                    allowed: "1..=layers.len()",
+                });
+            }
+            if !(0.0..=1.0).contains(&s.progress) {
+                return Err(ReportError::OutOfRange {
+                    field: format!("states[{si}].progress"),
+                    value: s.progress,
+                    allowed: "a fraction in [0, 1]",
+                });
+            }
+            if let Some(b) = s.blf {
+                finite(|| format!("states[{si}].blf"), b)?;
+            }
+            finite(|| format!("states[{si}].sigma_min"), s.sigma_min)?;
+            finite(|| format!("states[{si}].sigma_max"), s.sigma_max)?;
+            finite(|| format!("states[{si}].max_overhang"), s.max_overhang)?;
+            if let Some(stress) = &s.segment_stress {
+                let expected: usize = self
+                    .layers
+                    .iter()
+                    .take(s.layers_printed)
+                    .map(|l| l.segment_stress.len())
+                    .sum();
+                if stress.len() != expected {
+                    return Err(mismatch(
+                        format!("states[{si}].segment_stress"),
+                        stress.len(),
+                        expected,
+                    ));
+                }
+                for (k, v) in stress.iter().enumerate() {
+                    finite(|| format!("states[{si}].segment_stress[{k}]"), *v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl RobotAnimation {
+    fn validate(&self) -> Result<(), ReportError> {
+        let n = self.times.len();
+        if self.joints.len() != n {
+            return Err(mismatch("robot.joints".into(), self.joints.len(), n));
+        }
+        if self.poses.len() != n {
+            return Err(mismatch("robot.poses".into(), self.poses.len(), n));
+        }
+        let mut last = f64::NEG_INFINITY;
+        for (i, &t) in self.times.iter().enumerate() {
+            finite(|| format!("robot.times[{i}]"), t)?;
+            if t < last {
+                return Err(ReportError::OutOfRange {
+                    field: format!("robot.times[{i}]"),
+                    value: t,
+                    allowed: "times non-decreasing",
+                });
+            }
+            last = t;
+        }
+        for (i, q) in self.joints.iter().enumerate() {
+            for (j, v) in q.iter().enumerate() {
+                finite(|| format!("robot.joints[{i}][{j}]"), *v)?;
+            }
+        }
+        for (j, &r) in self.link_radii.iter().enumerate() {
+            if !(r.is_finite() && r > 0.0) {
+                return Err(ReportError::OutOfRange {
+                    field: format!("robot.link_radii[{j}]"),
+                    value: r,
+                    allowed: "a finite radius > 0 m",
+                });
+            }
+        }
+        for (i, pose) in self.poses.iter().enumerate() {
+            if pose.len() != self.link_radii.len() {
+                return Err(mismatch(
+                    format!("robot.poses[{i}]"),
+                    pose.len(),
+                    self.link_radii.len(),
+                ));
+            }
+            for (j, [a, b]) in pose.iter().enumerate() {
+                finite3(|| format!("robot.poses[{i}][{j}][0]"), a)?;
+                finite3(|| format!("robot.poses[{i}][{j}][1]"), b)?;
+            }
+        }
+        Ok(())
+    }
+}

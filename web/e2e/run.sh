@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# End-to-end test of the HTML report (issue 8), called by .ci/run:
+# writes the demo report, opens it from file:// in headless Debian `chromium` driven by
+# playwright-core (never `playwright`, never a browser download) and checks it (report.test.mjs).
+# Installs what a fresh machine lacks: chromium via apt-get, playwright-core via `npm ci`.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+if ! command -v chromium >/dev/null 2>&1; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
+  echo "installing chromium (apt-get)"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends \
+    chromium fonts-dejavu-core >/dev/null
+fi
+chromium --version 2>/dev/null | head -1 || true
+
+# The committed three.js bundle is the one web/build.sh recorded.
+(cd crates/report/assets && sha256sum -c --quiet three-vendor.min.js.sha256)
+
+(cd web && npm ci --no-audit --no-fund --loglevel=error)
+
+OUT=$(mktemp -d)
+trap 'rm -rf "$OUT"' EXIT
+cargo run --quiet -p kappe-report --example demo -- "$OUT/report.html"
+KAPPE_REPORT="$OUT/report.html" KAPPE_SCREENSHOT="${KAPPE_SCREENSHOT:-$OUT/report.png}" \
+  node --test web/e2e/
