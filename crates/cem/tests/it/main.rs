@@ -1,4 +1,7 @@
 //! Integration tests of kappe-cem (one test binary, modules by topic).
 
 mod common;
+mod fixed_geometry;
 mod fixtures;
+mod properties;
+mod validation;
