@@ -13,3 +13,90 @@ pub const EXAMPLE_ARCH_JSON: &str = include_str!("example_arch.json");
 pub fn example_arch() -> Result<TopologyFile, CemError> {
     read_topology(EXAMPLE_ARCH_JSON)
 }
+
+/// A vault grid like the `vault_grid*` fixtures (cem.md §9): `arches` parallel arches along
+/// Y (spacing 0.5), each two compression trails of `nodes_per_trail` nodes (λ = −0.3) from
+/// crown origins at (±0.3, y, 5) joined by a crown edge μ = −8; longitudinal direct
+/// deviation edges (μ = +0.2) join neighbouring arches at every sequence; gravity
+/// (0, 0, −0.1) on every non-support node. Node `j` of side `s` of arch `a` has id
+/// `2·n·a + n·s + j` with `n = nodes_per_trail`.
+///
+/// With `braced`, indirect diagonals (μ = +0.1) join node `j` of one arch to node `j + 1`
+/// of the next, on both sides, so the solve iterates.
+pub fn vault_grid(arches: usize, nodes_per_trail: usize, braced: bool) -> crate::Topology {
+    use crate::topology::{DeviationEdge, Node, Topology, TrailEdge};
+    use nalgebra::Vector3;
+    let n = nodes_per_trail;
+    let id = |a: usize, s: usize, j: usize| (2 * n * a + n * s + j) as u64;
+    let mut t = Topology {
+        name: format!(
+            "vault_grid{}{}",
+            2 * n * arches,
+            if braced { "_braced" } else { "" }
+        ),
+        ..Topology::default()
+    };
+    for a in 0..arches {
+        for s in 0..2 {
+            let dir = if s == 0 { -1.0 } else { 1.0 };
+            for j in 0..n {
+                let last = j + 1 == n;
+                t.nodes.push(Node {
+                    id: id(a, s, j),
+                    xyz: Vector3::new(
+                        dir * (0.3 + 0.25 * j as f64),
+                        0.5 * a as f64,
+                        5.0 - 0.2 * j as f64,
+                    ),
+                    load: if last {
+                        Vector3::zeros()
+                    } else {
+                        Vector3::new(0.0, 0.0, -0.1)
+                    },
+                    support: last,
+                    origin: None,
+                });
+                if j > 0 {
+                    t.trail_edges.push(TrailEdge {
+                        u: id(a, s, j - 1),
+                        v: id(a, s, j),
+                        length: -0.3,
+                        plane: None,
+                    });
+                }
+            }
+        }
+    }
+    for a in 0..arches {
+        t.deviation_edges.push(DeviationEdge {
+            u: id(a, 0, 0),
+            v: id(a, 1, 0),
+            force: -8.0,
+        });
+    }
+    for a in 0..arches.saturating_sub(1) {
+        for s in 0..2 {
+            for j in 0..n {
+                t.deviation_edges.push(DeviationEdge {
+                    u: id(a, s, j),
+                    v: id(a + 1, s, j),
+                    force: 0.2,
+                });
+            }
+        }
+    }
+    if braced {
+        for a in 0..arches.saturating_sub(1) {
+            for s in 0..2 {
+                for j in 0..n - 1 {
+                    t.deviation_edges.push(DeviationEdge {
+                        u: id(a, s, j),
+                        v: id(a + 1, s, j + 1),
+                        force: 0.1,
+                    });
+                }
+            }
+        }
+    }
+    t
+}

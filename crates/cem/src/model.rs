@@ -128,7 +128,9 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, 
         finite3(|| format!("node {} xyz", n.id), &n.xyz)?;
         finite3(|| format!("node {} load", n.id), &n.load)?;
     }
-    let mut pairs: HashMap<(NodeId, NodeId), String> = HashMap::new();
+    // Edge descriptions are only formatted on error: this check runs on every solve.
+    let mut pairs: HashMap<(NodeId, NodeId), (&'static str, NodeId, NodeId)> =
+        HashMap::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
     let mut check_pair = |kind: &'static str, u: NodeId, v: NodeId| -> Result<(), CemError> {
         for id in [u, v] {
             if !index.contains_key(&id) {
@@ -142,13 +144,12 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, 
             return Err(CemError::SelfLoop { kind, u });
         }
         let key = (u.min(v), u.max(v));
-        let desc = format!("{kind} edge ({u}, {v})");
-        if let Some(first) = pairs.insert(key, desc.clone()) {
+        if let Some((k0, u0, v0)) = pairs.insert(key, (kind, u, v)) {
             return Err(CemError::DuplicateEdge {
                 u,
                 v,
-                first,
-                second: desc,
+                first: format!("{k0} edge ({u0}, {v0})"),
+                second: format!("{kind} edge ({u}, {v})"),
             });
         }
         Ok(())
