@@ -53,6 +53,16 @@ pub enum ReportError {
         /// What is allowed.
         allowed: &'static str,
     },
+    /// A link that would leave the study directory or needs the network.
+    #[error(
+        "{field} = {href:?} is not allowed; use a relative path inside the study directory (no scheme, no leading /, no ..)"
+    )]
+    BadLink {
+        /// Path of the field.
+        field: String,
+        /// The link.
+        href: String,
+    },
     /// plotters failed to draw a plot.
     #[error("plot {plot:?} could not be drawn: {message}")]
     Plot {

@@ -10,6 +10,8 @@
 //! runs npm), a small hand-written viewer, the scene data as a JSON island and the plots as
 //! inline SVG (plotters; no fonts needed at generation time).
 //!
+//! [`render_study_html`] writes the design-study table of `kappe study` ([`StudyTable`]).
+//!
 //! ```
 //! use kappe_report::{demo_input, render_html};
 //! let html = render_html(&demo_input()).unwrap();
@@ -21,6 +23,7 @@ mod error;
 mod html;
 mod input;
 mod plots;
+mod study;
 
 pub use demo::demo_input;
 pub use error::ReportError;
@@ -33,6 +36,7 @@ pub use input::{
     RobotAnimation, Series, Vec3,
 };
 pub use plots::{PLOT_SIZE, PlotSpec, ReferenceLine, fmt_num, render_svg, standard_plots};
+pub use study::{StudyCell, StudyColumn, StudyRow, StudyTable, render_study_html};
 
 /// The three.js revision of the vendored bundle (`THREE.REVISION`).
 pub const THREE_REVISION: &str = "187";

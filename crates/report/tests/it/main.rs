@@ -2,6 +2,7 @@
 
 mod demo;
 mod html;
+mod study;
 mod validate;
 
 /// The text between `<script type="application/json" id="kappe-data">` and its `</script>`.
