@@ -106,10 +106,12 @@ test('report.html renders offline in headless Chromium and the slider changes th
   assert.equal(await page.locator('#constraints tr.fail').count(), data.constraints.filter((c) => !c.pass).length);
   assert.ok(await page.locator('#plots svg').count() >= 3, 'plots missing');
 
-  // Back to the final state for the screenshot.
+  // Back to the final state for the screenshot, the robot at the end of its trajectory
+  // (printing the last layer).
   await page.locator('#state-slider').fill(String(last));
+  if (data.robot) await page.locator('#robot-time').fill(String(data.robot.times.length - 1));
   if (process.env.KAPPE_SCREENSHOT) {
-    await page.screenshot({ path: process.env.KAPPE_SCREENSHOT, clip: { x: 0, y: 0, width: 1400, height: 820 } });
+    await page.screenshot({ path: process.env.KAPPE_SCREENSHOT, clip: { x: 0, y: 0, width: 1400, height: 850 } });
   }
   assert.deepEqual(requests, [], 'the page fetched something');
   assert.deepEqual(problems, [], 'console errors / page errors');
