@@ -45,6 +45,7 @@ pub mod example;
 pub mod fixed_geometry;
 pub mod json;
 pub mod model;
+pub mod optimize;
 pub mod topology;
 
 pub use equilibrium::{
@@ -54,6 +55,10 @@ pub use equilibrium::{
 pub use error::CemError;
 pub use fixed_geometry::{ForcePass, force_pass};
 pub use model::Model;
+pub use optimize::{
+    Bounds, Goal, OptimizeOptions, OptimizeResult, OptimizeStatus, Parameter, ParameterKind,
+    Problem, WeightedGoal, optimize,
+};
 pub use topology::{
     AuxiliaryTrails, DeviationEdge, Node, NodeId, Plane, Topology, TopologyBuilder, TrailEdge,
     TrailShift,

@@ -3,5 +3,6 @@
 mod common;
 mod fixed_geometry;
 mod fixtures;
+mod optimize;
 mod properties;
 mod validation;
