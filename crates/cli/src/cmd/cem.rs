@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
 use kappe_cem::json::{TopologyFile, equilibrium_to_json, read_topology};
-use kappe_cem::{Equilibrium, SolverOptions};
+use kappe_cem::{Equilibrium, OptimizeResult, Problem, SolverOptions};
+use serde_json::json;
 
 use crate::output::write_file_atomic;
 
@@ -14,6 +15,21 @@ use crate::output::write_file_atomic;
 pub enum CemCommand {
     /// Solve the equilibrium of a topology; writes a `kappe.cem.expected`-shaped result.
     Solve(SolveArgs),
+    /// Constrained form-finding: optimize the parameters of the `optimization` block so the
+    /// goals are met; writes the final equilibrium plus an `optimization` report.
+    Optimize(OptimizeArgs),
+}
+
+#[derive(Args)]
+pub struct OptimizeArgs {
+    /// Input topology with an `optimization` block (`kappe.cem.topology` v1 JSON).
+    input: PathBuf,
+    /// Output file (written atomically); stdout when absent.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Write the result and exit 0 even if the optimizer stopped short of convergence.
+    #[arg(long)]
+    allow_partial: bool,
 }
 
 #[derive(Args)]
@@ -38,6 +54,7 @@ pub struct SolveArgs {
 pub fn run(cmd: CemCommand) -> Result<ExitCode> {
     match cmd {
         CemCommand::Solve(args) => solve(args),
+        CemCommand::Optimize(args) => optimize(args),
     }
 }
 
@@ -120,6 +137,98 @@ fn summary(eq: &Equilibrium, solver: &SolverOptions, source: &str) -> String {
             s,
             "  {:>8}  {:>14.6} {:>14.6} {:>14.6}",
             n.id, r.x, r.y, r.z
+        );
+    }
+    s
+}
+
+fn optimize(args: OptimizeArgs) -> Result<ExitCode> {
+    let file = load(Some(&args.input), false)?;
+    let source = args.input.display().to_string();
+    let Some(block) = &file.optimization else {
+        bail!("{source} has no `optimization` block; nothing to optimize (use `kappe cem solve`)");
+    };
+    let (problem, options) = Problem::from_json(block)
+        .with_context(|| format!("invalid optimization block in {source}"))?;
+    let r = kappe_cem::optimize(&file.topology, &problem, &options)
+        .with_context(|| format!("cannot optimize {source}"))?;
+    let report = optimization_report(&r);
+    eprint!("{report}");
+    if !r.converged && !args.allow_partial {
+        bail!(
+            "the optimizer stopped short ({}, objective {:.3e}); no output written (use --allow-partial to keep it)",
+            r.status.name(),
+            r.objective_at_x_opt
+        );
+    }
+    let mut doc = equilibrium_to_json(&r.equilibrium, &options.solver, false);
+    if let serde_json::Value::Object(m) = &mut doc {
+        m.insert(
+            "optimization".into(),
+            json!({
+                "x0": r.x0,
+                "bounds_low": r.bounds_low,
+                "bounds_up": r.bounds_up,
+                "objective_at_x0": r.objective_at_x0,
+                "gradient_at_x0": r.gradient_at_x0,
+                "x_opt": r.x_opt,
+                "objective_at_x_opt": r.objective_at_x_opt,
+                "gradient_at_x_opt": r.gradient_at_x_opt,
+                "status": r.status.name(),
+                "converged": r.converged,
+                "iterations": r.iterations,
+                "evaluations": r.evaluations,
+                "goals": r.goals.iter().map(|g| json!({
+                    "goal": g.goal,
+                    "weight": g.weight,
+                    "error": g.error,
+                    "weighted_squared_error": g.weighted_squared_error,
+                })).collect::<Vec<_>>(),
+            }),
+        );
+    }
+    let mut text = serde_json::to_string_pretty(&doc).context("cannot serialize the result")?;
+    text.push('\n');
+    match &args.output {
+        Some(out) => write_file_atomic(out, text.as_bytes())?,
+        None => print!("{text}"),
+    }
+    Ok(if r.converged {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(2)
+    })
+}
+
+fn optimization_report(r: &OptimizeResult) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "status {} ({}), {} iterations, {} evaluations, objective {:.3e} -> {:.3e}",
+        r.status.name(),
+        if r.converged {
+            "converged"
+        } else {
+            "NOT converged"
+        },
+        r.iterations,
+        r.evaluations,
+        r.objective_at_x0,
+        r.objective_at_x_opt
+    );
+    let _ = writeln!(s, "  x0    {:?}", r.x0);
+    let _ = writeln!(s, "  x_opt {:?}", r.x_opt);
+    let _ = writeln!(
+        s,
+        "  {:<32} {:>8} {:>14} {:>14}",
+        "goal", "weight", "error", "w*e^2"
+    );
+    for g in &r.goals {
+        let _ = writeln!(
+            s,
+            "  {:<32} {:>8.3} {:>14.3e} {:>14.3e}",
+            g.goal, g.weight, g.error, g.weighted_squared_error
         );
     }
     s
