@@ -6,7 +6,6 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 
-#[allow(dead_code)] // used by the subcommands as they land
 /// Write `bytes` to `path` atomically (temp file in the same directory, then rename).
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = match path.parent() {
@@ -22,7 +21,6 @@ pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     Ok(())
 }
 
-#[allow(dead_code)] // used by the subcommands as they land
 /// Build a whole output directory atomically: `fill` writes into a fresh temporary
 /// directory next to `dir`, which then replaces `dir` (an existing `dir` is removed
 /// only after everything was written).

@@ -277,7 +277,7 @@ pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
         s = arc_now / (2 * nt_new + 1) as f64;
         nt = nt_new;
     }
-    if !(objective < 1e-20) {
+    if objective.is_nan() || objective >= 1e-20 {
         return Err(DesignError::FormFinding(format!(
             "the feet did not reach the springing lines (squared error {objective:.3e} m²): no compression \
              arch of this span and rise"

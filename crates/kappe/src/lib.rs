@@ -9,12 +9,16 @@
 pub mod analysis;
 pub mod arch;
 pub mod error;
+pub mod export;
+pub mod forces;
 pub mod frame;
 pub mod mesh;
 pub mod path;
+pub mod pipeline;
 pub mod section;
 pub mod spec;
 pub mod states;
 
 pub use error::DesignError;
+pub use pipeline::{Cap, StateSummary, design_cap};
 pub use spec::Design;

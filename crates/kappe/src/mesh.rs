@@ -107,7 +107,7 @@ impl TriMesh {
             }
         }
         let idx_len = bin.len() - pos_len;
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         if self.positions.is_empty() {
@@ -132,7 +132,7 @@ impl TriMesh {
             ]
         });
         let mut json_bytes = serde_json::to_vec(&json).unwrap_or_default();
-        while json_bytes.len() % 4 != 0 {
+        while !json_bytes.len().is_multiple_of(4) {
             json_bytes.push(b' ');
         }
         let total = 12 + 8 + json_bytes.len() + 8 + bin.len();

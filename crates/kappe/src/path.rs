@@ -102,7 +102,14 @@ impl PrintPath {
         for p in &self.points {
             s.push_str(&format!(
                 "{},{},{:.9},{:.9},{:.9},{:.12},{:.12},{:.12}\n",
-                p.layer, p.index, p.tip.x, p.tip.y, p.tip.z, p.axis.x, p.axis.y, p.axis.z
+                p.layer,
+                p.index,
+                p.tip.x + 0.0,
+                p.tip.y + 0.0,
+                p.tip.z + 0.0,
+                p.axis.x + 0.0,
+                p.axis.y + 0.0,
+                p.axis.z + 0.0
             ));
         }
         s

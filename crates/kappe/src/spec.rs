@@ -338,7 +338,7 @@ impl Design {
         check(
             "cap.length",
             c.length,
-            n_layers >= 1.0 && n_layers <= 5000.0,
+            (1.0..=5000.0).contains(&n_layers),
             format!(
                 "gives {n_layers:.1} centre layers; allowed 1 to 5000 (length·cos(tilt)/layer height)"
             ),

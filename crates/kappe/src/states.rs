@@ -137,7 +137,7 @@ pub fn build_state(
             } else {
                 -(sections.translations[m + 1] - sections.translations[m]).normalize()
             };
-            if !(d >= -1e-12 && d <= 1.0 + 1e-12) || r.dot(&e) <= 0.0 {
+            if !(-1e-12..=1.0 + 1e-12).contains(&d) || r.dot(&e) <= 0.0 {
                 return Err(DesignError::State {
                     state: top,
                     message: format!(
