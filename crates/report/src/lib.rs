@@ -12,6 +12,23 @@
 //!
 //! [`render_study_html`] writes the design-study table of `kappe study` ([`StudyTable`]).
 //!
+//! ## Filling [`ReportInput`] from the pipeline (for `kappe design`)
+//! - `layers`: in print order (−K..−1, 0..N−1); `nodes` = the layer's bead centre line,
+//!   `segment_stress` = final-state σ of its deviation edges (N/(lw·lh), compression < 0),
+//!   `plane_normal` = n = (0, cos am, sin am), `overhang` = l_o of method.md §3 (`None` for the
+//!   first layer).
+//! - `bed_joints`: the trail edges between layers, `layer` = id of the upper layer.
+//! - `states`: one per analysed state; `layers_printed` counts layers in print order;
+//!   `segment_stress` (optional) = that state's σ of the printed layers' segments, concatenated.
+//! - `print_path`: nozzle tip points, tool axis (−n), layer id per point.
+//! - `robot`: per time step the joint values and the world end points of each link capsule
+//!   (from FK), `link_radii` one per capsule; any number of capsules.
+//! - `constraints`: worst value per constraint; rows named `blf`, `sigma_min`, `sigma_max`,
+//!   `overhang` also draw their limits in the plots (units `kPa`/`Pa`/`MPa`, `mm`/`m`).
+//!
+//! Write the string with the CLI's `write_file_atomic`; the page is about 0.8 MB plus the data
+//! (8 MB at the default design's size with per-state stresses, see `examples/size_table.rs`).
+//!
 //! ```
 //! use kappe_report::{demo_input, render_html};
 //! let html = render_html(&demo_input()).unwrap();
