@@ -45,8 +45,8 @@ mod study;
 pub use demo::demo_input;
 pub use error::ReportError;
 pub use html::{
-    REPORT_CSS, THREE_BUNDLE, THREE_LICENSE, VIEWER_JS, escape_html, escape_inline_script,
-    render_html, scene_json,
+    ISLAND_SIGNIFICANT_DIGITS, REPORT_CSS, THREE_BUNDLE, THREE_LICENSE, VIEWER_JS, escape_html,
+    escape_inline_script, render_html, scene_json,
 };
 pub use input::{
     BedJoint, Bound, ConstraintRow, Layer, Parameter, Plot, PrintPath, PrintState, ReportInput,
