@@ -193,9 +193,9 @@ pub fn layer_topology(
 /// length s; goals the feet at (∓Cs/2, 0, 0); the crown origins at z = Cr, `s` apart. The loads
 /// depend on s, so the constrained problem is solved inside a fixed-point loop on s.
 ///
-/// The constrained problem is a square 2 × 2 system (foot x and z; y follows because the loads
-/// lie in the layer plane), solved by Newton's method on CEM solves with an exact-in-the-limit
-/// central-difference Jacobian; the answer is the zero-objective optimum of the constrained CEM.
+/// Each constrained problem is `kappe_cem::optimize` (SLSQP, exact forward-mode gradients) with
+/// two parameters, the crown force and one length shared by every trail edge (both kept in
+/// compression), and two point goals, the feet.
 pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
     let cat = Catenary::new(spec.span, spec.rise, spec.tilt, spec.specific_weight);
     let arc = cat.arc_length(spec.span);
@@ -205,62 +205,17 @@ pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
     let mut s = arc / (2 * nt + 1) as f64;
     let mut mu = -gamma_a * cat.a / spec.tilt.cos();
     let opts = kappe_cem::SolverOptions::default();
-    let target = V3::new(-0.5 * spec.span, 0.0, 0.0);
-    let foot_error =
-        |nt: usize, s_load: f64, len: f64, mu: f64| -> Result<(f64, f64), DesignError> {
-            let topo = layer_topology(spec, nt, s_load, len, mu);
-            let eq = kappe_cem::solve(&topo, &opts)?;
-            let p = eq.position(nt as u64).ok_or_else(|| {
-                DesignError::FormFinding("foot node missing from the CEM result".into())
-            })?;
-            Ok((p.x - target.x, p.z - target.z))
-        };
     let mut iterations = 0;
     let mut objective = f64::INFINITY;
     for _ in 0..3 {
-        // Fixed point on the load length s.
+        // Fixed point on the load length s: loads and crown origins frozen at s, constrained CEM
+        // for (μ, common trail length), repeat until s stops moving.
         for it in 0..60 {
             iterations += 1;
             let s_load = s;
-            let mut len = s;
-            // Newton on (mu, len) with the loads and origins frozen at s_load.
-            for _ in 0..50 {
-                let (ex, ez) = foot_error(nt, s_load, len, mu)?;
-                objective = ex * ex + ez * ez;
-                if objective < 1e-28 {
-                    break;
-                }
-                let hm = 1e-6 * mu.abs().max(1e-9);
-                let hl = 1e-7 * len;
-                let (a1, b1) = foot_error(nt, s_load, len, mu + hm)?;
-                let (a0, b0) = foot_error(nt, s_load, len, mu - hm)?;
-                let (c1, d1) = foot_error(nt, s_load, len + hl, mu)?;
-                let (c0, d0) = foot_error(nt, s_load, len - hl, mu)?;
-                let j = [
-                    [(a1 - a0) / (2.0 * hm), (c1 - c0) / (2.0 * hl)],
-                    [(b1 - b0) / (2.0 * hm), (d1 - d0) / (2.0 * hl)],
-                ];
-                let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-                if !det.is_finite() || det.abs() < 1e-300 {
-                    return Err(DesignError::FormFinding(
-                        "singular Jacobian of the foot position".into(),
-                    ));
-                }
-                let mut dmu = -(j[1][1] * ex - j[0][1] * ez) / det;
-                let mut dlen = -(-j[1][0] * ex + j[0][0] * ez) / det;
-                // Damp steps that would flip the crown thrust or the edge length.
-                let mut scale: f64 = 1.0;
-                if mu + dmu >= 0.0 {
-                    scale = scale.min(0.5 * mu.abs() / dmu.abs());
-                }
-                if len + dlen <= 0.0 {
-                    scale = scale.min(0.5 * len / dlen.abs());
-                }
-                dmu *= scale;
-                dlen *= scale;
-                mu += dmu;
-                len += dlen;
-            }
+            let (len, mu_new, obj) = constrained_layer(spec, nt, s_load, mu)?;
+            objective = obj;
+            mu = mu_new;
             s = len;
             if (s - s_load).abs() <= 1e-15 * s.max(1.0) && it > 0 {
                 break;
@@ -324,4 +279,62 @@ pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
         weight_iterations: iterations,
         objective,
     })
+}
+
+/// One constrained CEM solve of the layer: loads and origins frozen at `s_load`; returns the
+/// common trail length, the crown force and the final objective.
+fn constrained_layer(
+    spec: &ArchSpec,
+    nt: usize,
+    s_load: f64,
+    mu0: f64,
+) -> Result<(f64, f64, f64), DesignError> {
+    use kappe_cem::optimize::{
+        Bounds, Goal, OptimizeOptions, Parameter, ParameterKind, Problem, WeightedGoal,
+    };
+    let topo = layer_topology(spec, nt, s_load, s_load, mu0);
+    let edges: Vec<(u64, u64)> = topo.trail_edges.iter().map(|e| (e.u, e.v)).collect();
+    let tiny = 1e-9 * s_load;
+    let problem = Problem {
+        parameters: vec![
+            Parameter::new(
+                ParameterKind::DeviationForce(0, nt as u64 + 1),
+                Bounds::Absolute {
+                    lower: f64::NEG_INFINITY,
+                    upper: -1e-12 * mu0.abs(),
+                },
+            ),
+            Parameter::new(
+                ParameterKind::TrailLengths(edges),
+                Bounds::Absolute {
+                    lower: -10.0 * spec.span,
+                    upper: -tiny,
+                },
+            ),
+        ],
+        goals: [(nt as u64, -1.0), (2 * nt as u64 + 1, 1.0)]
+            .into_iter()
+            .map(|(node, side)| WeightedGoal {
+                goal: Goal::Point {
+                    node,
+                    target: V3::new(side * 0.5 * spec.span, 0.0, 0.0),
+                },
+                weight: 1.0,
+            })
+            .collect(),
+    };
+    let options = OptimizeOptions {
+        max_evaluations: 400,
+        stopval: 1e-30,
+        ftol_abs: 1e-32,
+        keep_states: true,
+        ..Default::default()
+    };
+    let res = kappe_cem::optimize::optimize(&topo, &problem, &options)?;
+    let (Some(&mu), Some(&len)) = (res.x_opt.first(), res.x_opt.get(1)) else {
+        return Err(DesignError::FormFinding(
+            "the optimizer returned no parameters".into(),
+        ));
+    };
+    Ok((len.abs(), mu, res.objective_at_x_opt))
 }
