@@ -90,3 +90,29 @@ fn force_pass_grid5000(b: divan::Bencher) {
         .collect();
     b.bench(|| kappe_cem::force_pass(divan::black_box(&t), &pos).expect("passes"));
 }
+
+/// Constrained form-finding (targets ≤ 10 ms each).
+mod optimize {
+    use kappe_cem::{OptimizeOptions, Problem, optimize};
+
+    use super::*;
+
+    #[divan::bench]
+    fn opt_arch_span_rise(b: divan::Bencher) {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/fixtures/cem/opt_arch_span_rise.input.json"
+        );
+        let file = read_topology(&std::fs::read_to_string(path).expect("fixture")).expect("valid");
+        let (p, o) = Problem::from_json(file.optimization.as_ref().expect("block")).expect("valid");
+        b.bench(|| optimize(divan::black_box(&file.topology), &p, &o).expect("optimizes"));
+    }
+
+    /// 40-node tilted arch (2 × 20 nodes), crown force + one shared trail length, feet goals.
+    #[divan::bench]
+    fn tilted_arch40_span_rise(b: divan::Bencher) {
+        let (t, p) = kappe_cem::example::tilted_arch(20);
+        let o = OptimizeOptions::default();
+        b.bench(|| optimize(divan::black_box(&t), &p, &o).expect("optimizes"));
+    }
+}

@@ -425,7 +425,7 @@ pub struct Equilibrium {
     pub iterations: Iterations,
     /// Global checks.
     pub checks: Checks,
-    index: std::collections::HashMap<NodeId, usize>,
+    index: crate::model::IdIndex,
     dev_adj: Vec<Vec<usize>>,
     trail_adj: Vec<Vec<usize>>,
 }

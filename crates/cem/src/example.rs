@@ -100,3 +100,75 @@ pub fn vault_grid(arches: usize, nodes_per_trail: usize, braced: bool) -> crate:
     }
     t
 }
+
+/// A tilted arch (method.md §4 shape): two trails of `n` nodes from crown origins at height
+/// 0.5, loads (0, w·tan 20°, −w); one crown force and ONE length shared by all trail edges;
+/// goals: the feet at (∓0.4, 0, 0). `n ≥ 2` nodes per trail (2·n in all). The crown sits at y = −0.5·tan 20°, so the plane spanned
+/// by the x axis and the load direction passes through the feet line: the goals are reachable.
+pub fn tilted_arch(n: usize) -> (crate::Topology, crate::Problem) {
+    use crate::optimize::{Bounds, Goal, Parameter, ParameterKind, WeightedGoal};
+    use nalgebra::Vector3;
+    let w = 0.1;
+    let tan = 20f64.to_radians().tan();
+    let mut b = crate::Topology::builder();
+    let id = |s: usize, j: usize| (s * n + j) as u64;
+    for s in 0..2 {
+        let dir = if s == 0 { -1.0 } else { 1.0 };
+        for j in 0..n {
+            b = b.node(
+                id(s, j),
+                [
+                    dir * (0.05 + 0.1 * j as f64),
+                    -0.5 * tan,
+                    0.5 - 0.05 * j as f64,
+                ],
+            );
+            if j + 1 < n {
+                b = b.load(id(s, j), [0.0, w * tan, -w]);
+                b = b.trail_edge(id(s, j), id(s, j + 1), -0.06);
+            } else {
+                b = b.support(id(s, j));
+            }
+        }
+    }
+    let t = b
+        .deviation_edge(id(0, 0), id(1, 0), -1.0)
+        .build()
+        .expect("the example arch is valid");
+    let edges: Vec<(u64, u64)> = t.trail_edges.iter().map(|e| (e.u, e.v)).collect();
+    let problem = crate::Problem {
+        parameters: vec![
+            Parameter::new(
+                ParameterKind::DeviationForce(id(0, 0), id(1, 0)),
+                Bounds::Absolute {
+                    lower: -50.0,
+                    upper: -1e-3,
+                },
+            ),
+            Parameter::new(
+                ParameterKind::TrailLengths(edges),
+                Bounds::Absolute {
+                    lower: -0.5,
+                    upper: -1e-3,
+                },
+            ),
+        ],
+        goals: vec![
+            WeightedGoal {
+                goal: Goal::Point {
+                    node: id(0, n - 1),
+                    target: Vector3::new(-0.4, 0.0, 0.0),
+                },
+                weight: 1.0,
+            },
+            WeightedGoal {
+                goal: Goal::Point {
+                    node: id(1, n - 1),
+                    target: Vector3::new(0.4, 0.0, 0.0),
+                },
+                weight: 1.0,
+            },
+        ],
+    };
+    (t, problem)
+}

@@ -26,6 +26,48 @@ use nalgebra::Vector3;
 use crate::error::CemError;
 use crate::topology::{NodeId, Topology};
 
+/// Node id → model index. Ids are usually dense small integers, so ids below a cap
+/// (4·n + 1024) live in a plain table and only the rest in a hash map: the lookups of
+/// trail building dominated a 500-node solve with a hash map alone.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct IdIndex {
+    dense: Vec<usize>,
+    sparse: HashMap<NodeId, usize>,
+}
+
+impl IdIndex {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            dense: vec![usize::MAX; 4 * n + 1024],
+            sparse: HashMap::new(),
+        }
+    }
+
+    pub(crate) fn get(&self, id: &NodeId) -> Option<&usize> {
+        match usize::try_from(*id).ok().and_then(|k| self.dense.get(k)) {
+            Some(i) if *i != usize::MAX => Some(i),
+            Some(_) => None,
+            None => self.sparse.get(id),
+        }
+    }
+
+    pub(crate) fn contains_key(&self, id: &NodeId) -> bool {
+        self.get(id).is_some()
+    }
+
+    /// Insert; returns the previous index if the id was present.
+    pub(crate) fn insert(&mut self, id: NodeId, i: usize) -> Option<usize> {
+        match usize::try_from(id).ok().and_then(|k| self.dense.get_mut(k)) {
+            Some(slot) => {
+                let old = *slot;
+                *slot = i;
+                (old != usize::MAX).then_some(old)
+            }
+            None => self.sparse.insert(id, i),
+        }
+    }
+}
+
 /// One node step of a sweep: the node, and for non-supports the outgoing trail edge and the
 /// next node of the trail.
 #[derive(Debug, Clone, Copy)]
@@ -74,7 +116,7 @@ pub(crate) struct AuxData {
 pub struct Model {
     pub(crate) name: String,
     pub(crate) ids: Vec<NodeId>,
-    pub(crate) index: HashMap<NodeId, usize>,
+    pub(crate) index: IdIndex,
     pub(crate) xyz0: Vec<Vector3<f64>>,
     pub(crate) loads: Vec<Vector3<f64>>,
     pub(crate) is_support: Vec<bool>,
@@ -119,8 +161,8 @@ fn finite3(what: impl Fn() -> String, v: &Vector3<f64>) -> Result<(), CemError> 
 }
 
 /// Element-level checks shared by [`crate::TopologyBuilder::build`] and [`Model::new`].
-pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, CemError> {
-    let mut index = HashMap::with_capacity(topo.nodes.len());
+pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
+    let mut index = IdIndex::with_capacity(topo.nodes.len());
     for (i, n) in topo.nodes.iter().enumerate() {
         if index.insert(n.id, i).is_some() {
             return Err(CemError::DuplicateNode { id: n.id });
@@ -128,10 +170,15 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, 
         finite3(|| format!("node {} xyz", n.id), &n.xyz)?;
         finite3(|| format!("node {} load", n.id), &n.load)?;
     }
-    // Edge descriptions are only formatted on error: this check runs on every solve.
-    let mut pairs: HashMap<(NodeId, NodeId), (&'static str, NodeId, NodeId)> =
-        HashMap::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
-    let mut check_pair = |kind: &'static str, u: NodeId, v: NodeId| -> Result<(), CemError> {
+    // Duplicate pairs are found by sorting after the loop; descriptions are only formatted
+    // on error (this check runs on every solve).
+    let mut pairs: Vec<((NodeId, NodeId), usize)> =
+        Vec::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
+    let check_pair = |pairs: &mut Vec<((NodeId, NodeId), usize)>,
+                      kind: &'static str,
+                      u: NodeId,
+                      v: NodeId|
+     -> Result<(), CemError> {
         for id in [u, v] {
             if !index.contains_key(&id) {
                 return Err(CemError::UnknownNode {
@@ -143,19 +190,12 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, 
         if u == v {
             return Err(CemError::SelfLoop { kind, u });
         }
-        let key = (u.min(v), u.max(v));
-        if let Some((k0, u0, v0)) = pairs.insert(key, (kind, u, v)) {
-            return Err(CemError::DuplicateEdge {
-                u,
-                v,
-                first: format!("{k0} edge ({u0}, {v0})"),
-                second: format!("{kind} edge ({u}, {v})"),
-            });
-        }
+        let k = pairs.len();
+        pairs.push(((u.min(v), u.max(v)), k));
         Ok(())
     };
     for e in &topo.trail_edges {
-        check_pair("trail", e.u, e.v)?;
+        check_pair(&mut pairs, "trail", e.u, e.v)?;
         finite(|| format!("trail edge ({}, {}) length", e.u, e.v), e.length)?;
         if let Some(p) = &e.plane {
             finite3(
@@ -172,11 +212,31 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<HashMap<NodeId, usize>, 
         }
     }
     for e in &topo.deviation_edges {
-        check_pair("deviation", e.u, e.v)?;
+        check_pair(&mut pairs, "deviation", e.u, e.v)?;
         finite(
             || format!("deviation edge ({}, {}) force", e.u, e.v),
             e.force,
         )?;
+    }
+    pairs.sort_unstable();
+    if let Some(w) = pairs.windows(2).find(|w| w[0].0 == w[1].0) {
+        let n_trail = topo.trail_edges.len();
+        let describe = |k: usize| match k.checked_sub(n_trail) {
+            None => topo
+                .trail_edges
+                .get(k)
+                .map_or_else(String::new, |e| format!("trail edge ({}, {})", e.u, e.v)),
+            Some(d) => topo.deviation_edges.get(d).map_or_else(String::new, |e| {
+                format!("deviation edge ({}, {})", e.u, e.v)
+            }),
+        };
+        let ((u, v), _) = w[1];
+        return Err(CemError::DuplicateEdge {
+            u,
+            v,
+            first: describe(w[0].1),
+            second: describe(w[1].1),
+        });
     }
     if let Some(aux) = &topo.auxiliary_trails {
         finite(|| "auxiliary_trails.length".to_string(), aux.length)?;

@@ -3,10 +3,7 @@
 
 use kappe_cem::json::read_topology;
 use kappe_cem::optimize::Evaluator;
-use kappe_cem::{
-    Bounds, Goal, OptimizeOptions, Parameter, ParameterKind, Problem, Topology, WeightedGoal,
-    optimize,
-};
+use kappe_cem::{Bounds, Goal, OptimizeOptions, ParameterKind, Problem, Topology, optimize};
 use nalgebra::Vector3;
 
 use crate::common::{close_rel, f, read_expected, read_input, v3};
@@ -106,76 +103,9 @@ fn perturbed_starts_converge_to_the_same_optimum() {
     }
 }
 
-/// A tilted arch (method.md §4 shape): two trails of `n` nodes from crown origins at height
-/// 0.5, loads (0, w·tan 20°, −w); one crown force and ONE length shared by all trail edges;
-/// goals: the feet at (∓0.4, 0, 0). The crown sits at y = −0.5·tan 20°, so the plane spanned
-/// by the x axis and the load direction passes through the feet line: the goals are reachable.
-pub fn tilted_arch(n: usize) -> (Topology, Problem) {
-    let w = 0.1;
-    let tan = 20f64.to_radians().tan();
-    let mut b = Topology::builder();
-    let id = |s: usize, j: usize| (s * n + j) as u64;
-    for s in 0..2 {
-        let dir = if s == 0 { -1.0 } else { 1.0 };
-        for j in 0..n {
-            b = b.node(
-                id(s, j),
-                [
-                    dir * (0.05 + 0.1 * j as f64),
-                    -0.5 * tan,
-                    0.5 - 0.05 * j as f64,
-                ],
-            );
-            if j + 1 < n {
-                b = b.load(id(s, j), [0.0, w * tan, -w]);
-                b = b.trail_edge(id(s, j), id(s, j + 1), -0.06);
-            } else {
-                b = b.support(id(s, j));
-            }
-        }
-    }
-    let t = b.deviation_edge(id(0, 0), id(1, 0), -1.0).build().unwrap();
-    let edges: Vec<(u64, u64)> = t.trail_edges.iter().map(|e| (e.u, e.v)).collect();
-    let problem = Problem {
-        parameters: vec![
-            Parameter::new(
-                ParameterKind::DeviationForce(id(0, 0), id(1, 0)),
-                Bounds::Absolute {
-                    lower: -50.0,
-                    upper: -1e-3,
-                },
-            ),
-            Parameter::new(
-                ParameterKind::TrailLengths(edges),
-                Bounds::Absolute {
-                    lower: -0.5,
-                    upper: -1e-3,
-                },
-            ),
-        ],
-        goals: vec![
-            WeightedGoal {
-                goal: Goal::Point {
-                    node: id(0, n - 1),
-                    target: Vector3::new(-0.4, 0.0, 0.0),
-                },
-                weight: 1.0,
-            },
-            WeightedGoal {
-                goal: Goal::Point {
-                    node: id(1, n - 1),
-                    target: Vector3::new(0.4, 0.0, 0.0),
-                },
-                weight: 1.0,
-            },
-        ],
-    };
-    (t, problem)
-}
-
 #[test]
 fn shared_length_tilted_arch_hits_span_and_rise() {
-    let (t, p) = tilted_arch(20);
+    let (t, p) = kappe_cem::example::tilted_arch(20);
     let r = optimize(&t, &p, &OptimizeOptions::default()).unwrap();
     assert!(
         r.converged && r.objective_at_x_opt <= 1e-12,
