@@ -606,6 +606,22 @@ impl Scene {
         self.soup.add_chain(layer_tag + 1, idx, points, radius);
     }
 
+    /// Smallest distance between this scene's static shapes and obstacle `o` (None if either
+    /// has no static shape, e.g. capsule chains).
+    pub fn distance_to(&self, o: &Obstacle) -> Option<f64> {
+        let other = Scene::new(std::slice::from_ref(o)).ok()?;
+        let mut best: Option<f64> = None;
+        for a in &self.shapes {
+            for b in &other.shapes {
+                if let Ok(d) = query::distance(&a.pose, a.shape.as_ref(), &b.pose, b.shape.as_ref())
+                {
+                    best = Some(best.map_or(d.distance, |x: f64| x.min(d.distance)));
+                }
+            }
+        }
+        best
+    }
+
     /// Nearest object to the given capsules (already in world coordinates), considering printed
     /// layers with tag < `layer_tag` and everything static. Distances above `cutoff` are reported
     /// as `cutoff` with no object.

@@ -4,12 +4,27 @@
 //! Frames follow the rerun naming `a_from_b` ([`frames`]). The base frame is the UR DH base
 //! (controller Base), the flange is DH frame 6, a TCP pose is `base_from_flange · flange_from_tcp`.
 
+// Joint loops `for j in 0..6` index several parallel arrays (q, limits, speeds); iterator
+// zips would hide which joint is meant.
+#![allow(clippy::needless_range_loop)]
+
+pub mod base;
+pub mod check;
 pub mod collision;
 pub mod error;
 pub mod frames;
 pub mod kinematics;
 pub mod ladder;
+pub mod plan;
+pub mod setup;
+pub mod synthetic;
 
+pub use check::{CheckReport, check_plan};
 pub use error::{FailureKind, PlanFailure, RobotError};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
+pub use plan::{LayerPlan, Plan, Station, Waypoint, plan_print};
+pub use setup::{
+    BasePlacement, BaseSearch, PathPoint, PlanOptions, PlannerKind, PrintLayer, ProgramOptions,
+    RobotSetup, Tool, ToolCapsule,
+};

@@ -5,3 +5,4 @@ mod collision;
 mod common;
 mod kinematics;
 mod ladder;
+mod plan;

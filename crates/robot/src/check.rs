@@ -1,0 +1,205 @@
+//! Independent re-verification of a plan from its joint values alone: FK against the stored
+//! targets, joint limits, singularity margins, self-collision, clearance to the environment and
+//! the printed layers, continuity and joint speeds inside layers, monotonic time, and the
+//! transitions between layers. Nothing computed by the planner (clearances, costs) is trusted.
+
+use parry3d_f64::glamx::DVec3;
+use serde::Serialize;
+
+use crate::frames::{Iso, angle_between};
+use crate::kinematics::{JOINT_LIMITS, MAX_JOINT_SPEED, UR10E, within_limits};
+use crate::plan::{CLEARANCE_CUTOFF, Plan, transition_collision, validate};
+use crate::setup::{PathPoint, PrintLayer};
+
+/// Tolerance of the TCP position (m) and tool axis (rad) on the targets (acceptance: 1e-6).
+pub const TARGET_TOL: f64 = 1e-6;
+
+/// Result of [`check_plan`]; the plan is valid when `problems` is empty.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CheckReport {
+    pub waypoints: usize,
+    pub max_position_error: f64,
+    pub max_axis_error: f64,
+    pub min_clearance: f64,
+    pub min_self_distance: f64,
+    pub max_speed_ratio: f64,
+    pub problems: Vec<String>,
+}
+
+/// Re-verify `plan`. At most 20 problems are listed (with a count of the rest).
+pub fn check_plan(plan: &Plan) -> CheckReport {
+    let mut rep = CheckReport {
+        min_clearance: f64::INFINITY,
+        min_self_distance: f64::INFINITY,
+        ..Default::default()
+    };
+    let mut problems = Vec::new();
+    let layers: Vec<PrintLayer> = plan
+        .stations
+        .iter()
+        .flat_map(|s| &s.layers)
+        .map(|l| PrintLayer {
+            layer: l.layer,
+            points: l
+                .waypoints
+                .iter()
+                .map(|w| PathPoint {
+                    index: w.index,
+                    position: w.position,
+                    axis: w.axis,
+                })
+                .collect(),
+        })
+        .collect();
+    let ctx = match validate(&layers, &plan.setup, &plan.options) {
+        Ok(c) => c,
+        Err(e) => {
+            rep.problems
+                .push(format!("the plan's setup or targets are invalid: {e}"));
+            return rep;
+        }
+    };
+    let flange_from_tcp = match Iso::from_mat4(&plan.flange_from_tcp) {
+        Ok(t) => t,
+        Err(e) => {
+            rep.problems.push(format!("flange_from_tcp: {e}"));
+            return rep;
+        }
+    };
+    if flange_from_tcp.max_abs_diff(&ctx.flange_from_tcp) > 1e-12 {
+        problems.push("flange_from_tcp differs from the setup's tool".to_string());
+    }
+    let opts = &plan.options;
+    let mut order = 0usize;
+    let mut last_t = f64::NEG_INFINITY;
+    for (si, st) in plan.stations.iter().enumerate() {
+        let world_from_base = match Iso::from_mat4(&st.world_from_base) {
+            Ok(w) => w,
+            Err(e) => {
+                problems.push(format!("station {si}: world_from_base {e}"));
+                order += st.layers.len();
+                continue;
+            }
+        };
+        if let Err(e) = ctx.check_base(&world_from_base) {
+            problems.push(format!("station {si}: {e}"));
+        }
+        let scene = match ctx.scene(&world_from_base) {
+            Ok(s) => s,
+            Err(e) => {
+                problems.push(format!("station {si}: {e}"));
+                order += st.layers.len();
+                continue;
+            }
+        };
+        let mut prev_end: Option<[f64; 6]> = None;
+        for l in &st.layers {
+            if let (Some(a), Some(w0)) = (prev_end, l.waypoints.first())
+                && let Some(msg) =
+                    transition_collision(&ctx, &scene, &world_from_base, &a, &w0.q, order)
+            {
+                problems.push(format!("move into layer {}: {msg}", l.layer));
+            }
+            let mut branch = None;
+            for (k, w) in l.waypoints.iter().enumerate() {
+                rep.waypoints += 1;
+                let at = || format!("station {si} layer {} point {}", l.layer, w.index);
+                let q = w.q;
+                if !q.iter().all(|v| v.is_finite()) {
+                    problems.push(format!("{}: non-finite joints", at()));
+                    continue;
+                }
+                if w.t.partial_cmp(&last_t).is_none_or(|o| o.is_lt()) {
+                    problems.push(format!("{}: time {} s goes backwards", at(), w.t));
+                }
+                last_t = w.t;
+                let base_flange = UR10E.fk(&q);
+                let world_tcp = world_from_base.mul(&base_flange).mul(&flange_from_tcp);
+                let dp = (world_tcp.t - DVec3::from(w.position)).length();
+                let da = angle_between(world_tcp.r.z_axis, DVec3::from(w.axis));
+                rep.max_position_error = rep.max_position_error.max(dp);
+                rep.max_axis_error = rep.max_axis_error.max(da);
+                if dp > TARGET_TOL || da > TARGET_TOL {
+                    problems.push(format!(
+                        "{}: TCP misses the target by {dp:.3e} m, axis by {da:.3e} rad",
+                        at()
+                    ));
+                }
+                if !within_limits(&q, &JOINT_LIMITS) {
+                    problems.push(format!("{}: joints {q:?} outside the limits", at()));
+                }
+                if !ctx.margins_ok(&q, &base_flange) {
+                    problems.push(format!(
+                        "{}: singularity margin violated (|sin q5| = {:.4}, |sin q3| = {:.4}, shoulder {:.4} m)",
+                        at(),
+                        q[4].sin().abs(),
+                        q[2].sin().abs(),
+                        UR10E.shoulder_margin(&base_flange)
+                    ));
+                }
+                let b = (q[2].sin() > 0.0, q[4].sin() > 0.0);
+                if *branch.get_or_insert(b) != b {
+                    problems.push(format!(
+                        "{}: elbow/wrist branch changes inside the layer",
+                        at()
+                    ));
+                }
+                let posed = ctx.self_model.pose(&q, &Iso::IDENTITY);
+                let (ds, pair) = ctx.self_model.min_self_distance_posed(&posed);
+                rep.min_self_distance = rep.min_self_distance.min(ds);
+                // 1e-9 m: round-off of re-posing the same capsules.
+                if ds < opts.self_clearance - 1e-9 {
+                    problems.push(format!(
+                        "{}: self distance {ds:.4} m between links {pair:?}",
+                        at()
+                    ));
+                }
+                let env = ctx.env_model.pose(&q, &world_from_base);
+                let c = scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
+                rep.min_clearance = rep.min_clearance.min(c.distance);
+                if c.distance < opts.clearance - 1e-9 {
+                    problems.push(format!(
+                        "{}: clearance {:.4} m to {:?} below the margin {} m",
+                        at(),
+                        c.distance,
+                        c.object.unwrap_or_default(),
+                        opts.clearance
+                    ));
+                }
+                if k > 0 {
+                    let p = &l.waypoints[k - 1];
+                    let dt = w.t - p.t;
+                    for j in 0..6 {
+                        let dq = (w.q[j] - p.q[j]).abs();
+                        let ratio = if dt > 0.0 {
+                            dq / dt / MAX_JOINT_SPEED[j]
+                        } else if dq > 0.0 {
+                            f64::INFINITY
+                        } else {
+                            0.0
+                        };
+                        rep.max_speed_ratio = rep.max_speed_ratio.max(ratio);
+                        // 1e-9: relative slack for the division.
+                        if ratio > opts.speed_fraction * (1.0 + 1e-9) {
+                            problems.push(format!(
+                                "{}: joint {} at {:.3} of its speed limit",
+                                at(),
+                                j + 1,
+                                ratio
+                            ));
+                        }
+                    }
+                }
+            }
+            prev_end = l.waypoints.last().map(|w| w.q);
+            order += 1;
+        }
+    }
+    let n = problems.len();
+    if n > 20 {
+        problems.truncate(20);
+        problems.push(format!("… and {} more", n - 20));
+    }
+    rep.problems = problems;
+    rep
+}

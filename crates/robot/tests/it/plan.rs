@@ -1,0 +1,116 @@
+//! Planning a small synthetic cap (robot.md §7 "Planning on a cap") and bad input.
+
+use kappe_robot::frames::Iso;
+use kappe_robot::synthetic::cap_path;
+use kappe_robot::*;
+
+/// A short cap: 16 layers of 12 points, base 1.0 m in front of the first layer (see
+/// `examples/try_bases.rs`: from there the first ~60 layers are reachable).
+fn small() -> (Vec<PrintLayer>, RobotSetup, PlanOptions) {
+    let layers = cap_path(0.8, 0.2, 25.0, 0.008, 16, 12);
+    let setup = RobotSetup {
+        base: BasePlacement::Fixed {
+            world_from_base: Iso::translation(0.0, 1.0, 0.0)
+                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
+                .to_mat4(),
+        },
+        ..RobotSetup::default()
+    };
+    (layers, setup, PlanOptions::default())
+}
+
+#[test]
+fn plans_and_verifies_a_small_cap() {
+    let (layers, setup, opts) = small();
+    let plan = plan_print(&layers, &setup, &opts).unwrap();
+    assert_eq!(plan.waypoint_count(), 16 * 12);
+    let rep = check_plan(&plan);
+    assert!(rep.problems.is_empty(), "{:?}", rep.problems);
+    // Acceptance: TCP on target ≤ 1e-6 m and axis ≤ 1e-6 rad (closed-form IK gives ~1e-15).
+    assert!(rep.max_position_error <= 1e-6 && rep.max_axis_error <= 1e-6);
+    assert!(rep.min_clearance >= opts.clearance);
+    assert!(rep.max_speed_ratio <= opts.speed_fraction);
+    // Layers keep their ids and point indices, times increase.
+    let ls: Vec<i64> = plan.stations[0].layers.iter().map(|l| l.layer).collect();
+    assert_eq!(ls, (0..16).collect::<Vec<_>>());
+    // The random planner is never better than the optimal one on the same graph.
+    let rnd = plan_print(
+        &layers,
+        &setup,
+        &PlanOptions {
+            planner: PlannerKind::Random,
+            random_trials: 3,
+            ..opts.clone()
+        },
+    )
+    .unwrap();
+    assert!(
+        rnd.cost >= plan.cost - 1e-9,
+        "random {} < optimal {}",
+        rnd.cost,
+        plan.cost
+    );
+}
+
+#[test]
+fn tampered_plan_fails_the_check() {
+    let (layers, setup, opts) = small();
+    let mut plan = plan_print(&layers[..3], &setup, &opts).unwrap();
+    plan.stations[0].layers[1].waypoints[4].q[1] += 1e-3;
+    let rep = check_plan(&plan);
+    assert!(
+        rep.problems
+            .iter()
+            .any(|p| p.contains("layer 1 point 4") && p.contains("misses the target")),
+        "{:?}",
+        rep.problems
+    );
+}
+
+#[test]
+fn bad_input_is_named() {
+    let (layers, mut setup, opts) = small();
+    let e = plan_print(
+        &layers,
+        &setup,
+        &PlanOptions {
+            epsilon: 0.0,
+            ..opts.clone()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("epsilon"), "{e}");
+    let mut zero = setup.clone();
+    zero.tool.flange_from_tcp = Iso::IDENTITY.to_mat4();
+    let e = plan_print(&layers, &zero, &opts).unwrap_err().to_string();
+    assert!(e.contains("zero length"), "{e}");
+    // Base inside an obstacle.
+    setup.obstacles.push(kappe_robot::collision::Obstacle::Box {
+        name: "pillar".into(),
+        center: [0.0, 1.0, 0.0],
+        half_extents: [0.3, 0.3, 1.0],
+        yaw: 0.0,
+    });
+    let e = plan_print(&layers, &setup, &opts).unwrap_err();
+    assert!(
+        matches!(&e, RobotError::Unplannable(f) if f.kind == FailureKind::BasePlacement),
+        "{e}"
+    );
+    assert!(e.to_string().contains("pillar"), "{e}");
+    // Unreachable: a layer 3 m away names its first point.
+    let mut far = layers[..2].to_vec();
+    far[1].points[3].position[0] += 3.0;
+    setup.obstacles.clear();
+    let e = plan_print(&far, &setup, &opts).unwrap_err();
+    match e {
+        RobotError::Unplannable(f) => {
+            assert_eq!(
+                (f.layer, f.index, f.kind.clone()),
+                (1, 3, FailureKind::Unreachable),
+                "{f}"
+            );
+        }
+        other => panic!("{other}"),
+    }
+}
