@@ -252,7 +252,7 @@ impl Design {
             c.rise,
             (0.05..=1.0).contains(&ratio),
             format!(
-                "rise/span = {ratio:.3}; a compression arch of this method needs 0.05 ≤ rise/span ≤ 1 \
+                "rise/span = {ratio:.3}; allowed: 0.05 ≤ rise/span ≤ 1 for a compression arch of this method \
                  (flatter arches have unbounded thrust, steeper ones are not caps)"
             ),
         )?;
