@@ -12,6 +12,7 @@ pub mod base;
 pub mod check;
 pub mod collision;
 pub mod error;
+pub mod export;
 pub mod frames;
 pub mod kinematics;
 pub mod ladder;
@@ -21,6 +22,7 @@ pub mod synthetic;
 
 pub use check::{CheckReport, check_plan};
 pub use error::{FailureKind, PlanFailure, RobotError};
+pub use export::{urscript_programs, write_plan_json, write_trajectory_csv, write_urscript};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
 pub use plan::{LayerPlan, Plan, Station, Waypoint, plan_print};

@@ -114,3 +114,65 @@ fn bad_input_is_named() {
         other => panic!("{other}"),
     }
 }
+
+#[test]
+fn exports_round_trip() {
+    let (layers, setup, opts) = small();
+    let opts = PlanOptions {
+        program: ProgramOptions {
+            max_moves_per_program: 50,
+            ..Default::default()
+        },
+        ..opts
+    };
+    let plan = plan_print(&layers[..8], &setup, &opts).unwrap();
+    // CSV: same joint values (exact round trip, checked at 1e-12) in plan order.
+    let mut csv = Vec::new();
+    write_trajectory_csv(&plan, &mut csv).unwrap();
+    let text = String::from_utf8(csv).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let wps: Vec<(i64, &Waypoint)> = plan.stations[0]
+        .layers
+        .iter()
+        .flat_map(|l| l.waypoints.iter().map(move |w| (l.layer, w)))
+        .collect();
+    assert_eq!(rows.len(), wps.len());
+    for (r, (layer, w)) in rows.iter().zip(&wps) {
+        assert_eq!((r[1] as i64, r[2] as usize), (*layer, w.index));
+        for j in 0..6 {
+            assert!((r[4 + j] - w.q[j]).abs() <= 1e-12);
+        }
+    }
+    // URScript: one move per waypoint; 8 layers of 12 moves split into parts of ≤ 50 moves.
+    let mut script = Vec::new();
+    write_urscript(&plan, &mut script).unwrap();
+    let script = String::from_utf8(script).unwrap();
+    let moves = script
+        .lines()
+        .filter(|l| {
+            let t = l.trim_start();
+            t.starts_with("movej(") || t.starts_with("movep(")
+        })
+        .count();
+    assert_eq!(moves, plan.waypoint_count());
+    let parts = urscript_programs(&plan).unwrap();
+    // Whole layers only: ⌊50/12⌋ = 4 layers (48 moves) per part → ⌈8/4⌉ = 2 parts.
+    assert_eq!(parts.len(), 2);
+    for p in &parts {
+        assert_eq!(
+            p.lines()
+                .filter(|l| l.trim_start().starts_with("move"))
+                .count(),
+            48
+        );
+    }
+    // JSON round trip re-verifies.
+    let mut json = Vec::new();
+    write_plan_json(&plan, &mut json).unwrap();
+    let back: Plan = serde_json::from_slice(&json).unwrap();
+    assert!(check_plan(&back).problems.is_empty());
+}
