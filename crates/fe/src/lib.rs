@@ -41,6 +41,7 @@ pub mod assembly;
 pub mod element;
 pub mod error;
 mod factor;
+pub mod generate;
 pub mod mesh_json;
 pub mod model;
 pub mod oracle;

@@ -1,5 +1,12 @@
 //! Integration tests of kappe-fe: the acceptance checks A1–A12 of
 //! `../shared/reference/buckling.md` §7 (one test binary, modules per topic).
 
+// Index loops mirror the formulas (DOF d of node n).
+#![allow(clippy::needless_range_loop)]
+
+mod bad_input;
+mod closed_form;
 mod common;
+mod element_patch;
 mod fixtures;
+mod solver_checks;
