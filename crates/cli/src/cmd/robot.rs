@@ -1,18 +1,217 @@
-//! `kappe robot ...` (being built).
+//! `kappe robot ...`: UR10e IK, planning a print path CSV, re-checking a plan.
 
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use clap::Subcommand;
+use kappe_robot::{
+    Iso, Mat4, PathPoint, PlanOptions, PrintLayer, RobotSetup, UR10E, check_plan, plan_print,
+    urscript_programs, write_plan_json, write_trajectory_csv, write_urscript,
+};
+use serde::Deserialize;
+
+use crate::output::{write_dir_atomic, write_file_atomic};
 
 #[derive(Subcommand)]
 pub enum RobotCommand {
-    /// Not available yet.
-    Todo,
+    /// Flange poses → all closed-form IK solutions (JSON to stdout). POSES.json is a list of
+    /// row-major 4×4 matrices, or {"poses": [...], "flange_from_tcp": 4×4} for TCP poses.
+    Ik { poses: PathBuf },
+    /// Re-verify a plan JSON independently (FK vs targets, limits, collisions, continuity,
+    /// speeds); exit code 1 when it fails.
+    Check { plan: PathBuf },
+    /// Plan a print path CSV (`layer,index,x,y,z,tx,ty,tz`, world frame) and write
+    /// DIR/plan.json, DIR/trajectory.csv and DIR/program.script (+ program_partNN.script when
+    /// split).
+    Plan {
+        path: PathBuf,
+        /// Output directory (replaced atomically).
+        #[arg(long, default_value = "robot-out")]
+        out: PathBuf,
+        /// JSON with optional "setup" (RobotSetup) and "options" (PlanOptions).
+        #[arg(long)]
+        config: Option<PathBuf>,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum PosesFile {
+    List(Vec<Mat4>),
+    Tool {
+        poses: Vec<Mat4>,
+        flange_from_tcp: Option<Mat4>,
+    },
+}
+
+#[derive(Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+struct Config {
+    setup: RobotSetup,
+    options: PlanOptions,
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// Parse `layer,index,x,y,z,tx,ty,tz` rows into layers (in order of first appearance).
+fn read_path_csv(path: &Path) -> Result<Vec<PrintLayer>> {
+    let text = read(path)?;
+    let mut lines = text.lines().enumerate();
+    let header = lines.next().map(|(_, l)| l.trim()).unwrap_or("");
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    let want = ["layer", "index", "x", "y", "z", "tx", "ty", "tz"];
+    if cols.len() < 8 || cols[..8] != want {
+        bail!(
+            "{}: header is {header:?}, expected \"layer,index,x,y,z,tx,ty,tz\"",
+            path.display()
+        );
+    }
+    let mut layers: Vec<PrintLayer> = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let f: Vec<&str> = line.split(',').map(str::trim).collect();
+        if f.len() < 8 {
+            bail!(
+                "{} line {}: {} fields, expected 8",
+                path.display(),
+                i + 1,
+                f.len()
+            );
+        }
+        let layer: i64 = f[0]
+            .parse()
+            .with_context(|| format!("{} line {}: layer {:?}", path.display(), i + 1, f[0]))?;
+        let index: usize = f[1]
+            .parse()
+            .with_context(|| format!("{} line {}: index {:?}", path.display(), i + 1, f[1]))?;
+        let mut v = [0.0; 6];
+        for (k, slot) in v.iter_mut().enumerate() {
+            *slot = f[2 + k].parse().with_context(|| {
+                format!(
+                    "{} line {}: {} {:?}",
+                    path.display(),
+                    i + 1,
+                    want[2 + k],
+                    f[2 + k]
+                )
+            })?;
+        }
+        let p = PathPoint {
+            index,
+            position: [v[0], v[1], v[2]],
+            axis: [v[3], v[4], v[5]],
+        };
+        match layers.last_mut() {
+            Some(l) if l.layer == layer => l.points.push(p),
+            _ => {
+                if layers.iter().any(|l| l.layer == layer) {
+                    bail!(
+                        "{} line {}: layer {layer} appears again after another layer",
+                        path.display(),
+                        i + 1
+                    );
+                }
+                layers.push(PrintLayer {
+                    layer,
+                    points: vec![p],
+                });
+            }
+        }
+    }
+    Ok(layers)
 }
 
 pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
     match cmd {
-        RobotCommand::Todo => bail!("`kappe robot` is not available yet"),
+        RobotCommand::Ik { poses } => {
+            let file: PosesFile = serde_json::from_str(&read(&poses)?).with_context(|| {
+                format!(
+                    "{}: expected a list of 4×4 matrices or {{\"poses\", \"flange_from_tcp\"}}",
+                    poses.display()
+                )
+            })?;
+            let (list, tool) = match file {
+                PosesFile::List(l) => (l, None),
+                PosesFile::Tool {
+                    poses,
+                    flange_from_tcp,
+                } => (poses, flange_from_tcp),
+            };
+            let tcp_from_flange = match tool {
+                Some(m) => Iso::from_mat4(&m)
+                    .map_err(|e| anyhow::anyhow!("flange_from_tcp: {e}"))?
+                    .inverse(),
+                None => Iso::IDENTITY,
+            };
+            let mut out = Vec::new();
+            for (i, m) in list.iter().enumerate() {
+                let t = Iso::from_mat4(m).map_err(|e| anyhow::anyhow!("poses[{i}]: {e}"))?;
+                let sols = UR10E.ik_tcp(&t, &tcp_from_flange);
+                out.push(
+                    serde_json::json!({ "n_solutions": sols.len(), "solutions": sols.as_slice() }),
+                );
+            }
+            println!("{}", serde_json::to_string_pretty(&out)?);
+            Ok(ExitCode::SUCCESS)
+        }
+        RobotCommand::Check { plan } => {
+            let p: kappe_robot::Plan = serde_json::from_str(&read(&plan)?)
+                .with_context(|| format!("{} is not a kappe plan JSON", plan.display()))?;
+            let rep = check_plan(&p);
+            println!("{}", serde_json::to_string_pretty(&rep)?);
+            if rep.problems.is_empty() {
+                eprintln!("plan OK: {} waypoints verified", rep.waypoints);
+                Ok(ExitCode::SUCCESS)
+            } else {
+                eprintln!("plan FAILED: {} problem(s)", rep.problems.len());
+                Ok(ExitCode::FAILURE)
+            }
+        }
+        RobotCommand::Plan { path, out, config } => {
+            let layers = read_path_csv(&path)?;
+            let cfg: Config = match config {
+                Some(c) => serde_json::from_str(&read(&c)?)
+                    .with_context(|| format!("invalid config {}", c.display()))?,
+                None => Config::default(),
+            };
+            let plan = plan_print(&layers, &cfg.setup, &cfg.options)?;
+            let mut script = Vec::new();
+            write_urscript(&plan, &mut script)?;
+            let mut csv = Vec::new();
+            write_trajectory_csv(&plan, &mut csv)?;
+            let mut json = Vec::new();
+            write_plan_json(&plan, &mut json)?;
+            let parts = urscript_programs(&plan)?;
+            write_dir_atomic(&out, |dir| {
+                write_file_atomic(&dir.join("program.script"), &script)?;
+                write_file_atomic(&dir.join("trajectory.csv"), &csv)?;
+                write_file_atomic(&dir.join("plan.json"), &json)?;
+                if parts.len() > 1 {
+                    for (i, p) in parts.iter().enumerate() {
+                        write_file_atomic(
+                            &dir.join(format!("program_part{:02}.script", i + 1)),
+                            p.as_bytes(),
+                        )?;
+                    }
+                }
+                Ok(())
+            })?;
+            println!(
+                "planned {} waypoints in {} layers from {} station(s): joint motion {:.3} rad, print time {:.1} s, min clearance {:.4} m → {}",
+                plan.waypoint_count(),
+                layers.len(),
+                plan.stations.len(),
+                plan.joint_motion,
+                plan.print_time,
+                plan.min_clearance,
+                out.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
