@@ -95,14 +95,6 @@ impl Pattern {
         }
     }
 
-    /// Position of entry (i, j), i ≥ j, in the value array.
-    #[inline]
-    fn position(&self, i: usize, j: usize) -> Option<usize> {
-        let (a, b) = (*self.col_ptr.get(j)?, *self.col_ptr.get(j + 1)?);
-        let rows = self.row_idx.get(a..b)?;
-        rows.binary_search(&i).ok().map(|p| a + p)
-    }
-
     /// Number of stored (lower) entries.
     pub fn nnz(&self) -> usize {
         self.row_idx.len()
@@ -175,16 +167,32 @@ where
                 if j == usize::MAX {
                     continue;
                 }
-                for p in 0..18 {
-                    let i = fd[p];
-                    if i == usize::MAX || i < j {
-                        continue;
+                let (c0, c1) = (pattern.col_ptr[j], pattern.col_ptr[j + 1]);
+                let rows = &pattern.row_idx[c0..c1];
+                // The free DOFs of one node are consecutive numbers, hence consecutive rows:
+                // one binary search per node block instead of one per entry.
+                for a in 0..3 {
+                    let mut pos: Option<usize> = None;
+                    for p in 6 * a..6 * a + 6 {
+                        let i = fd[p];
+                        if i == usize::MAX || i < j {
+                            continue;
+                        }
+                        let at = match pos {
+                            Some(x) => x + 1,
+                            None => c0 + rows.partition_point(|&r| r < i),
+                        };
+                        if pattern.row_idx.get(at) != Some(&i) || at >= c1 {
+                            return Err(FeError::Numerical {
+                                stage: "assembly",
+                                detail: format!(
+                                    "entry ({i}, {j}) missing from the sparsity pattern"
+                                ),
+                            });
+                        }
+                        vals[at] += ke[(p, q)];
+                        pos = Some(at);
                     }
-                    let pos = pattern.position(i, j).ok_or(FeError::Numerical {
-                        stage: "assembly",
-                        detail: format!("entry ({i}, {j}) missing from the sparsity pattern"),
-                    })?;
-                    vals[pos] += ke[(p, q)];
                 }
             }
         }

@@ -477,13 +477,19 @@ impl BucklingSolver {
             t_symbolic: self.t_symbolic,
             ..SolveStats::default()
         };
-        let st = self.static_internal(model, &mut stats)?;
+        let StaticInternal {
+            result: static_result,
+            llt,
+            kvals,
+            geo,
+        } = self.static_internal(model, &mut stats)?;
         let t0 = Instant::now();
         let el = &*self.element;
-        let elements = &st.result.elements;
+        let elements = &static_result.elements;
         let kg = assemble(model, &self.dofs, &self.pattern, |e| {
-            el.geometric_stiffness(&st.geo[e], &elements[e].resultants.membrane)
+            el.geometric_stiffness(&geo[e], &elements[e].resultants.membrane)
         })?;
+        drop(geo);
         stats.t_geometric += t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
@@ -496,11 +502,13 @@ impl BucklingSolver {
         };
         let ops = Ops {
             pattern: &self.pattern,
-            k: &st.kvals,
+            k: &kvals,
             kg: &kg,
-            llt: &st.llt,
         };
-        let mut found = lanczos(&ops, k, options, &[], max_steps, &mut stats)?;
+        let mut found = lanczos(&ops, &llt, k, options, &[], max_steps, &mut stats)?;
+        // The factor of K is released before the Sturm LDLᵀ so the two never coexist (peak
+        // memory at 10⁵ nodes); a deflated restart re-factors K, which is rarely needed.
+        drop(llt);
         stats.t_eigen = t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
@@ -509,7 +517,7 @@ impl BucklingSolver {
             let mut rounds = 0;
             loop {
                 let lam_max = found.iter().map(|p| p.lambda).fold(0.0, f64::max);
-                let (sigma, neg) = self.sturm_count(&st.kvals, &kg, lam_max * (1.0 + 1e-4))?;
+                let (sigma, neg) = self.sturm_count(&kvals, &kg, lam_max * (1.0 + 1e-4))?;
                 let below = found.iter().filter(|p| p.lambda <= sigma).count();
                 sturm = Some(SturmCheck {
                     sigma,
@@ -530,7 +538,22 @@ impl BucklingSolver {
                 // Deflated restart: the Krylov space is kept K-orthogonal to the found modes,
                 // so it converges to the missed (e.g. repeated) factors.
                 let locked: Vec<Vec<f64>> = found.iter().map(|p| p.vector.clone()).collect();
-                let extra = lanczos(&ops, neg - below, options, &locked, max_steps, &mut stats)?;
+                let llt = match self.symbolic.llt(&kvals) {
+                    Ok(l) => l,
+                    Err(LltFailure::NotPositive(idx)) => {
+                        return Err(self.mechanism(&kvals, &self.diagonal(&kvals), idx));
+                    }
+                    Err(LltFailure::Other(e)) => return Err(e),
+                };
+                let extra = lanczos(
+                    &ops,
+                    &llt,
+                    neg - below,
+                    options,
+                    &locked,
+                    max_steps,
+                    &mut stats,
+                )?;
                 if extra.is_empty() {
                     return Err(FeError::SturmMismatch {
                         sigma,
@@ -569,7 +592,7 @@ impl BucklingSolver {
             modes,
             residuals,
             sturm,
-            static_result: st.result,
+            static_result,
             stats,
         })
     }
@@ -637,7 +660,6 @@ struct Ops<'a> {
     pattern: &'a Pattern,
     k: &'a [f64],
     kg: &'a [f64],
-    llt: &'a Llt<'a>,
 }
 
 impl Ops<'_> {
@@ -707,6 +729,7 @@ fn k_orthogonalize(ops: &Ops<'_>, basis: &[&[f64]], r: &mut [f64], kr: &mut [f64
 /// positive μ = 1/λ, K-orthogonal to `locked_in`.
 fn lanczos(
     ops: &Ops<'_>,
+    llt: &Llt<'_>,
     want: usize,
     options: &BucklingOptions,
     locked_in: &[Vec<f64>],
@@ -746,7 +769,7 @@ fn lanczos(
                 ops.kg_mul(&x, &mut y);
                 y.iter_mut().for_each(|v| *v = -*v);
                 let mut m = Mat::<f64>::from_fn(n, 1, |i, _| y[i]);
-                ops.llt.solve_in_place(m.as_mut())?;
+                llt.solve_in_place(m.as_mut())?;
                 stats.operator_applications += 1;
                 (0..n).map(|i| m[(i, 0)]).collect()
             }
@@ -773,7 +796,7 @@ fn lanczos(
             tmp.iter_mut().for_each(|v| *v = -*v);
             alpha.push(dot(&q[j], &tmp));
             let mut m = Mat::<f64>::from_fn(n, 1, |i, _| tmp[i]);
-            ops.llt.solve_in_place(m.as_mut())?;
+            llt.solve_in_place(m.as_mut())?;
             stats.operator_applications += 1;
             steps += 1;
             r = (0..n).map(|i| m[(i, 0)]).collect();
