@@ -47,6 +47,7 @@ fn design_writes_every_output_and_init_round_trips() {
         csv.lines().count() as u64 - 1,
         summary["counts"]["path_points"].as_u64().unwrap()
     );
+    check_trajectory_against_path(&out, &summary);
     // init refuses to overwrite.
     assert!(!kappe().arg("init").arg(&toml).status().unwrap().success());
 }
@@ -87,4 +88,118 @@ fn bad_design_names_the_field_and_writes_nothing() {
         .map(|e| e.file_name())
         .collect();
     assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+}
+
+type M4 = [[f64; 4]; 4];
+
+fn mul(a: &M4, b: &M4) -> M4 {
+    let mut c = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            c[i][j] = (0..4).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    c
+}
+
+fn mat(v: &serde_json::Value) -> M4 {
+    let mut m = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            m[i][j] = v[i][j].as_f64().unwrap();
+        }
+    }
+    m
+}
+
+/// UR10e forward kinematics written here from the standard DH table (robot.md §1), independent
+/// of kappe-robot: base → flange.
+fn fk(q: &[f64; 6]) -> M4 {
+    let d = [0.1807, 0.0, 0.0, 0.17415, 0.11985, 0.11655];
+    let a = [0.0, -0.6127, -0.57155, 0.0, 0.0, 0.0];
+    let alpha = [
+        std::f64::consts::FRAC_PI_2,
+        0.0,
+        0.0,
+        std::f64::consts::FRAC_PI_2,
+        -std::f64::consts::FRAC_PI_2,
+        0.0,
+    ];
+    let mut t: M4 = [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ];
+    for i in 0..6 {
+        let (st, ct) = q[i].sin_cos();
+        let (sa, ca) = alpha[i].sin_cos();
+        let a_i: M4 = [
+            [ct, -st * ca, st * sa, a[i] * ct],
+            [st, ct * ca, -ct * sa, a[i] * st],
+            [0.0, sa, ca, d[i]],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        t = mul(&t, &a_i);
+    }
+    t
+}
+
+/// Every print waypoint's TCP lies on its path.csv target (≤ 1e-6 m) with the tool z axis along
+/// the target axis (≤ 1e-6 rad): the acceptance check of issue 7.
+fn check_trajectory_against_path(out: &std::path::Path, summary: &serde_json::Value) {
+    let robot = &summary["robot"];
+    assert_eq!(
+        robot["ok"],
+        serde_json::json!(true),
+        "robot not planned: {robot}"
+    );
+    let flange_from_tcp = mat(&robot["flange_from_tcp"]);
+    let stations: Vec<M4> = robot["stations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| mat(&s["world_from_base"]))
+        .collect();
+    let path = std::fs::read_to_string(out.join("path.csv")).unwrap();
+    let mut targets = std::collections::HashMap::new();
+    for line in path.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let v: Vec<f64> = f[2..8].iter().map(|x| x.parse().unwrap()).collect();
+        targets.insert((f[0].to_string(), f[1].to_string()), v);
+    }
+    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    let mut checked = 0;
+    for line in traj.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let Some(t) = targets.get(&(f[1].to_string(), f[2].to_string())) else {
+            continue;
+        };
+        let station: usize = f[0].parse().unwrap();
+        let q: Vec<f64> = f[4..10].iter().map(|x| x.parse().unwrap()).collect();
+        let world_from_tcp = mul(
+            &mul(
+                &stations[station],
+                &fk(&[q[0], q[1], q[2], q[3], q[4], q[5]]),
+            ),
+            &flange_from_tcp,
+        );
+        let pos_err = ((world_from_tcp[0][3] - t[0]).powi(2)
+            + (world_from_tcp[1][3] - t[1]).powi(2)
+            + (world_from_tcp[2][3] - t[2]).powi(2))
+        .sqrt();
+        let cos =
+            world_from_tcp[0][2] * t[3] + world_from_tcp[1][2] * t[4] + world_from_tcp[2][2] * t[5];
+        assert!(pos_err <= 1e-6, "TCP {pos_err:e} m off target at {line}");
+        assert!(
+            cos.clamp(-1.0, 1.0).acos() <= 1e-6,
+            "tool axis off at {line}"
+        );
+        checked += 1;
+    }
+    assert_eq!(
+        checked,
+        targets.len(),
+        "not every path point has a waypoint"
+    );
 }

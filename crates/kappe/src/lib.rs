@@ -8,6 +8,7 @@
 
 pub mod analysis;
 pub mod arch;
+pub mod constraints;
 pub mod error;
 pub mod export;
 pub mod forces;
@@ -15,7 +16,9 @@ pub mod frame;
 pub mod mesh;
 pub mod path;
 pub mod pipeline;
+pub mod robot_plan;
 pub mod section;
+pub mod shell;
 pub mod spec;
 pub mod states;
 

@@ -84,21 +84,55 @@ pub struct ConstraintSpec {
 }
 
 /// Robot and tool settings for the motion planner (method.md §8, robot.md).
+///
+/// `setup` and `plan` are the planner's own settings (`kappe_robot::RobotSetup` and
+/// `kappe_robot::PlanOptions`, documented there). The print speed, bead radius and bead offset
+/// of `plan` are always taken from `[print]` (speed, lw/2, lh/2), and the two support beams of
+/// `beams` are added to the obstacles.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RobotSpec {
     /// Plan the robot motion as part of `kappe design`.
     pub enabled: bool,
-    /// Length of the straight nozzle from the flange to the tip, m.
-    pub tool_length: f64,
-    /// Compatibility threshold ε on Σ(Δq)² between consecutive configurations, rad².
-    pub epsilon: f64,
-    /// Rotation step about the tool axis, degrees.
-    pub rotation_step_deg: f64,
-    /// Planner: "optimal" (exact shortest path) or "random" (paper, seeded).
-    pub planner: String,
-    /// Seed of the random planner.
-    pub seed: u64,
+    /// The support beams under the springing lines.
+    pub beams: BeamSpec,
+    /// Robot cell: base placement, tool, mobile base, floor, extra obstacles.
+    pub setup: kappe_robot::setup::RobotSetup,
+    /// Planner settings.
+    pub plan: kappe_robot::setup::PlanOptions,
+}
+
+/// Two beams along y whose tops are the base plane and whose inner faces are the springing lines.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BeamSpec {
+    /// Beam width across x, m.
+    pub width: f64,
+    /// Beam height below the base plane, m.
+    pub height: f64,
+    /// How far the beams run beyond the printed cap at both ends, m.
+    pub overrun: f64,
+}
+
+impl Default for BeamSpec {
+    fn default() -> Self {
+        BeamSpec {
+            width: 0.12,
+            height: 0.24,
+            overrun: 0.05,
+        }
+    }
+}
+
+impl Default for RobotSpec {
+    fn default() -> Self {
+        RobotSpec {
+            enabled: true,
+            beams: BeamSpec::default(),
+            setup: kappe_robot::setup::RobotSetup::default(),
+            plan: kappe_robot::setup::PlanOptions::default(),
+        }
+    }
 }
 
 impl Default for Design {
@@ -159,19 +193,6 @@ impl Default for ConstraintSpec {
     }
 }
 
-impl Default for RobotSpec {
-    fn default() -> Self {
-        RobotSpec {
-            enabled: true,
-            tool_length: 0.20,
-            epsilon: 0.05,
-            rotation_step_deg: 10.0,
-            planner: "optimal".into(),
-            seed: 1,
-        }
-    }
-}
-
 /// The embedded default design file, with comments (what `kappe init` writes).
 pub const EXAMPLE_TOML: &str = include_str!("default_design.toml");
 
@@ -191,10 +212,12 @@ impl Design {
         let design: Design = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner();
-            DesignError::Parse {
-                path,
-                message: inner.message().trim().to_string(),
-            }
+            let message = inner.message().trim().to_string();
+            let message = match did_you_mean(&message) {
+                Some(hint) => format!("{message} (did you mean `{hint}`?)"),
+                None => message,
+            };
+            DesignError::Parse { path, message }
         })?;
         design.validate()?;
         Ok(design)
@@ -369,32 +392,55 @@ impl Design {
                 "allowed: l_o,max > 0 m",
             )?;
         }
-        let r = &self.robot;
+        let bm = &self.robot.beams;
         check(
-            "robot.tool_length",
-            r.tool_length,
-            r.tool_length > 0.0 && r.tool_length <= 1.0,
-            "allowed: 0 < tool length ≤ 1 m",
+            "robot.beams.width",
+            bm.width,
+            bm.width > 0.0,
+            "allowed: width > 0 m",
         )?;
         check(
-            "robot.epsilon",
-            r.epsilon,
-            r.epsilon > 0.0,
-            "allowed: ε > 0 rad²",
+            "robot.beams.height",
+            bm.height,
+            bm.height > 0.0,
+            "allowed: height > 0 m",
         )?;
         check(
-            "robot.rotation_step_deg",
-            r.rotation_step_deg,
-            r.rotation_step_deg > 0.0 && r.rotation_step_deg <= 180.0,
-            "allowed: 0° < step ≤ 180°",
+            "robot.beams.overrun",
+            bm.overrun,
+            bm.overrun >= 0.0,
+            "allowed: overrun ≥ 0 m",
         )?;
-        if r.planner != "optimal" && r.planner != "random" {
-            return Err(DesignError::Invalid {
-                field: "robot.planner",
-                value: format!("{:?}", r.planner),
-                allowed: "allowed: \"optimal\" or \"random\"".into(),
-            });
-        }
         Ok(())
     }
+}
+
+/// For serde's "unknown field `x`, expected one of `a`, `b`, …", the expected name closest to `x`
+/// by edit distance (at most 3 edits), so a typo gets a concrete suggestion.
+fn did_you_mean(message: &str) -> Option<String> {
+    let rest = message.strip_prefix("unknown field `")?;
+    let (typo, rest) = rest.split_once('`')?;
+    let candidates: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(typo, c), c))
+        .filter(|(d, _)| *d <= 3)
+        .min()
+        .map(|(_, c)| c.to_string())
+}
+
+/// Levenshtein distance between two short strings.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
 }

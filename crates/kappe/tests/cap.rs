@@ -345,7 +345,7 @@ fn bad_fields_are_named_with_their_range() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("spam") && err.contains("span"),
+        err.contains("spam") && err.contains("did you mean `span`"),
         "unknown field: {err}"
     );
     let err = Design::from_toml_str("[cap\nspan = 1")

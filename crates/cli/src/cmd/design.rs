@@ -22,6 +22,12 @@ pub struct DesignArgs {
     /// Print the summary as JSON to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Skip robot motion planning (no trajectory.csv / program.script).
+    #[arg(long)]
+    pub no_robot: bool,
+    /// Exit with status 0 even when the design fails a constraint or cannot be planned.
+    #[arg(long)]
+    pub allow_fail: bool,
 }
 
 #[derive(Args)]
@@ -66,7 +72,42 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     };
     bar.finish_and_clear();
 
-    let summary = kappe::export::summary_json(&cap);
+    // Robot: plan (verified inside the planner) unless disabled.
+    let robot = if cap.design.robot.enabled && !args.no_robot {
+        let spinner = if args.quiet || args.json {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new_spinner()
+        };
+        spinner.set_message("planning the UR10e trajectory");
+        spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+        let plan = kappe::robot_plan::plan_robot(&cap);
+        spinner.finish_and_clear();
+        Some(plan)
+    } else {
+        None
+    };
+    let mut programs: Vec<String> = Vec::new();
+    let mut trajectory: Vec<u8> = Vec::new();
+    let mut program: Vec<u8> = Vec::new();
+    let robot_json = match &robot {
+        None => serde_json::json!({"planned": false, "reason": "disabled"}),
+        Some(Ok(plan)) => {
+            kappe_robot::write_trajectory_csv(plan, &mut trajectory)?;
+            kappe_robot::write_urscript(plan, &mut program)?;
+            programs = kappe_robot::urscript_programs(plan)?;
+            plan_summary(plan)
+        }
+        Some(Err(e)) => {
+            serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
+        }
+    };
+    let robot_ok = !matches!(robot, Some(Err(_)));
+
+    let mut summary = kappe::export::summary_json(&cap);
+    if let Some(obj) = summary.as_object_mut() {
+        obj.insert("robot".into(), robot_json);
+    }
     let network = kappe::export::network_json(&cap)?;
     write_dir_atomic(&args.out, |dir| {
         std::fs::write(
@@ -80,6 +121,18 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         std::fs::write(dir.join("path.csv"), cap.path.to_csv())?;
         std::fs::write(dir.join("cap.obj"), cap.mesh.to_obj(&cap.design.name))?;
         std::fs::write(dir.join("cap.glb"), cap.mesh.to_glb())?;
+        if !trajectory.is_empty() {
+            std::fs::write(dir.join("trajectory.csv"), &trajectory)?;
+        }
+        if !program.is_empty() {
+            std::fs::write(dir.join("program.script"), &program)?;
+        }
+        // Long programs also come as numbered parts that fit the controller, run in order.
+        if programs.len() > 1 {
+            for (i, p) in programs.iter().enumerate() {
+                std::fs::write(dir.join(format!("program_part{:02}.script", i + 1)), p)?;
+            }
+        }
         Ok(())
     })?;
 
@@ -87,8 +140,49 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if !args.quiet {
         print_table(&cap, &args.out);
+        match &robot {
+            Some(Ok(plan)) => println!(
+                "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm; \
+                 wrote trajectory.csv, program.script ({} part(s))",
+                plan.stations.len(),
+                plan.joint_motion,
+                plan.total_time / 60.0,
+                plan.min_clearance * 1e3,
+                programs.len()
+            ),
+            Some(Err(e)) => println!("  robot: NOT PLANNED: {e}"),
+            None => println!("  robot: planning skipped"),
+        }
+    }
+    if !robot_ok {
+        if let Some(Err(e)) = &robot {
+            eprintln!("error: the robot cannot print this design: {e}");
+        }
+        if !args.allow_fail {
+            return Ok(ExitCode::FAILURE);
+        }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
+fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
+    serde_json::json!({
+        "planned": true,
+        "ok": true,
+        "stations": plan.stations.iter().map(|s| serde_json::json!({
+            "world_from_base": s.world_from_base,
+            "layers": s.layers.iter().map(|l| l.layer).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "flange_from_tcp": plan.flange_from_tcp,
+        "joint_motion_rad": plan.joint_motion,
+        "cost_rad2": plan.cost,
+        "print_time_s": plan.print_time,
+        "total_time_s": plan.total_time,
+        "min_clearance_m": plan.min_clearance,
+        "min_self_distance_m": plan.min_self_distance,
+        "max_speed_ratio": plan.max_speed_ratio,
+    })
 }
 
 fn print_table(cap: &kappe::Cap, out: &std::path::Path) {

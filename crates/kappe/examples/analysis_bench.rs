@@ -1,0 +1,107 @@
+//! Benchmark of the full analysis of the default design (every state), with the time split
+//! (form-finding, stresses, FE per state), and a mesh study of the final state's BLF against the
+//! number of layers per shell mesh row.
+//!
+//! `cargo run --release -p kappe --example analysis_bench [-- STRIDE]`
+
+use std::time::Instant;
+
+use kappe::constraints::{AnalysisOptions, analyze, state_buckling, state_material};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let stride: usize = std::env::args()
+        .nth(1)
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(AnalysisOptions::default().row_stride);
+    let design = kappe::Design::default();
+    let t0 = Instant::now();
+    let cap = kappe::design_cap(&design, &|_| {})?;
+    let t_form = t0.elapsed().as_secs_f64();
+    let options = AnalysisOptions {
+        row_stride: stride,
+        ..AnalysisOptions::default()
+    };
+    let t1 = Instant::now();
+    let analysis = analyze(&cap, &options, &|_| {})?;
+    let t_analysis = t1.elapsed().as_secs_f64();
+    println!(
+        "default design, {} states, row stride {stride}",
+        cap.states.len()
+    );
+    println!("{:<44} {:>9}", "phase", "seconds");
+    println!(
+        "{:<44} {:>9.3}",
+        "form-finding + states + forces (design_cap)", t_form
+    );
+    println!(
+        "{:<44} {:>9.3}",
+        "stresses, wall (all states)", analysis.timings.stresses
+    );
+    println!(
+        "{:<44} {:>9.3}",
+        "stresses, sum over states", analysis.timings.stresses_sum
+    );
+    println!(
+        "{:<44} {:>9.3}",
+        "FE, wall (all states)", analysis.timings.fe
+    );
+    println!(
+        "{:<44} {:>9.3}",
+        "FE, sum over states", analysis.timings.fe_sum
+    );
+    println!("{:<44} {:>9.3}", "analysis total (wall)", t_analysis);
+    println!(
+        "{:<44} {:>9.3}",
+        "design + analysis total (wall)",
+        t_form + t_analysis
+    );
+    println!();
+    println!(
+        "{:>6} {:>6} {:>7} {:>9} {:>9}",
+        "state", "layer", "nodes", "BLF", "FE s"
+    );
+    for s in analysis
+        .states
+        .iter()
+        .step_by(8)
+        .chain(analysis.states.last())
+    {
+        println!(
+            "{:>6} {:>6} {:>7} {:>9.4} {:>9.3}",
+            s.index,
+            s.top_layer,
+            s.shell_nodes,
+            s.blf.unwrap_or(f64::NAN),
+            s.fe_seconds
+        );
+    }
+    println!();
+    print!("{}", analysis.report());
+
+    println!("\nmesh study, final state: BLF vs layers per mesh row");
+    let last = cap.states.len() - 1;
+    let state = kappe::states::build_state(
+        &cap.sections,
+        &cap.frame,
+        design.print.start_arch_fraction,
+        last,
+    )?;
+    for stride in [1usize, 2, 3, 4] {
+        let o = AnalysisOptions {
+            row_stride: stride,
+            modes: 3,
+            sturm_check: true,
+            ..AnalysisOptions::default()
+        };
+        let t = Instant::now();
+        let b = state_buckling(&state, &state_material(&cap, &o, last), &o)?;
+        println!(
+            "  stride {stride}: {:>5} nodes, BLF {:?}, {:.3} s (3 modes + Sturm check)",
+            b.shell_nodes,
+            b.factors,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
