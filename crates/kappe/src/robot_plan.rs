@@ -62,3 +62,75 @@ pub fn plan_robot(cap: &Cap) -> Result<Plan, kappe_robot::RobotError> {
     let (setup, opts) = robot_inputs(cap);
     kappe_robot::plan_print(&print_layers(&cap.path), &setup, &opts)
 }
+
+/// The arm drawn as capsules over time, for the report's animation.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ArmFrames {
+    /// Time of each frame, s.
+    pub times: Vec<f64>,
+    /// Joint values of each frame, rad.
+    pub joints: Vec<[f64; 6]>,
+    /// Radius of each capsule, m.
+    pub radii: Vec<f64>,
+    /// Per frame, the world end points of each capsule.
+    pub segments: Vec<Vec<[[f64; 3]; 2]>>,
+}
+
+/// Pose the UR10e capsule model (arm + tool) along the plan, at most `max_frames` evenly spread
+/// waypoints (the report embeds them; every waypoint would make the page large).
+pub fn arm_frames(
+    plan: &Plan,
+    tool: &kappe_robot::setup::Tool,
+    max_frames: usize,
+) -> Result<ArmFrames, kappe_robot::RobotError> {
+    use kappe_robot::collision::{CapsuleSpec, RobotModel};
+    // Tool capsules live on link 7 (the flange frame) in the robot crate's model.
+    let tool_specs: Vec<CapsuleSpec> = tool
+        .capsules
+        .iter()
+        .enumerate()
+        .map(|(i, c)| CapsuleSpec {
+            link: 7,
+            name: format!("tool_{i}"),
+            a: c.a,
+            b: c.b,
+            radius: c.radius,
+        })
+        .collect();
+    let model = RobotModel::ur10e_with_tool(&tool_specs)?;
+    let all: Vec<(usize, &kappe_robot::Waypoint)> = plan
+        .stations
+        .iter()
+        .enumerate()
+        .flat_map(|(s, st)| {
+            st.layers
+                .iter()
+                .flat_map(move |l| l.waypoints.iter().map(move |w| (s, w)))
+        })
+        .collect();
+    let stride = all.len().div_ceil(max_frames.max(1)).max(1);
+    let bases: Vec<kappe_robot::Iso> = plan
+        .stations
+        .iter()
+        .map(|s| kappe_robot::Iso::from_mat4_unchecked(&s.world_from_base))
+        .collect();
+    let mut out = ArmFrames::default();
+    for (k, (s, w)) in all.iter().enumerate() {
+        if k % stride != 0 && k + 1 != all.len() {
+            continue;
+        }
+        let posed = model.pose(&w.q, &bases[*s]);
+        let caps = posed.as_slice();
+        if out.radii.is_empty() {
+            out.radii = caps.iter().map(|c| c.radius).collect();
+        }
+        out.times.push(w.t);
+        out.joints.push(w.q);
+        out.segments.push(
+            caps.iter()
+                .map(|c| [[c.a.x, c.a.y, c.a.z], [c.b.x, c.b.y, c.b.z]])
+                .collect(),
+        );
+    }
+    Ok(out)
+}
