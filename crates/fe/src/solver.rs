@@ -708,19 +708,20 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// `r ← r − Σ (bᵢᵀ K r) bᵢ` over the K-orthonormal `basis`, twice (CGS2). Returns ‖r‖_K and
-/// leaves `kr = K r`.
-fn k_orthogonalize(ops: &Ops<'_>, basis: &[&[f64]], r: &mut [f64], kr: &mut [f64]) -> f64 {
+/// `r ← r − Σ (bᵢᵀ K r) bᵢ` over the K-orthonormal `basis`, twice (CGS2), given `kr = K r` and
+/// `kbasis = K·basis`; `kr` is updated alongside, so no K product is needed. Returns ‖r‖_K.
+fn k_orthogonalize(basis: &[&[f64]], kbasis: &[&[f64]], r: &mut [f64], kr: &mut [f64]) -> f64 {
     for _ in 0..2 {
-        ops.k_mul(r, kr);
-        let c: Vec<f64> = basis.iter().map(|b| dot(b, kr)).collect();
-        for (b, ci) in basis.iter().zip(&c) {
+        let c: Vec<f64> = kbasis.iter().map(|z| dot(z, r)).collect();
+        for ((b, z), ci) in basis.iter().zip(kbasis).zip(&c) {
             for (ri, bi) in r.iter_mut().zip(b.iter()) {
                 *ri -= ci * bi;
             }
+            for (ki, zi) in kr.iter_mut().zip(z.iter()) {
+                *ki -= ci * zi;
+            }
         }
     }
-    ops.k_mul(r, kr);
     dot(r, kr).max(0.0).sqrt()
 }
 
@@ -737,8 +738,8 @@ fn lanczos(
     stats: &mut SolveStats,
 ) -> Result<Vec<Pair>, FeError> {
     let n = ops.pattern.n;
-    // Memory cap on the basis: ~400 MB of vectors, between 30 and 300 of them.
-    let m_cap = (50_000_000 / n.max(1)).clamp(30, 300).min(n);
+    // Memory cap on the basis Q and K·Q: ~400 MB, between 30 and 300 vectors each.
+    let m_cap = (25_000_000 / n.max(1)).clamp(30, 300).min(n);
     let mut converged: Vec<Pair> = Vec::new();
     let mut steps = 0usize;
     let mut start: Option<Vec<f64>> = None;
@@ -754,13 +755,25 @@ fn lanczos(
         if locked.len() >= n {
             break;
         }
+        let locked_k: Vec<Vec<f64>> = locked
+            .iter()
+            .map(|v| {
+                let mut z = vec![0.0; n];
+                ops.k_mul(v, &mut z);
+                z
+            })
+            .collect();
         let m_max = m_cap.min(n - locked.len());
         // Start vector: W applied to a random (or restart) vector, so it lies in range(W).
         let mut q: Vec<Vec<f64>> = Vec::with_capacity(m_max + 1);
+        let mut z: Vec<Vec<f64>> = Vec::with_capacity(m_max + 1);
         let mut alpha: Vec<f64> = Vec::new();
         let mut beta: Vec<f64> = Vec::new();
         let x0: Vec<f64> = match start.take() {
-            Some(v) => v,
+            Some(v) => {
+                ops.k_mul(&v, &mut kr);
+                v
+            }
             None => {
                 let x: Vec<f64> = (0..n)
                     .map(|i| random_unit(options.seed.wrapping_add(restart), i as u64))
@@ -771,12 +784,14 @@ fn lanczos(
                 let mut m = Mat::<f64>::from_fn(n, 1, |i, _| y[i]);
                 llt.solve_in_place(m.as_mut())?;
                 stats.operator_applications += 1;
+                kr.copy_from_slice(&y);
                 (0..n).map(|i| m[(i, 0)]).collect()
             }
         };
         let mut r = x0;
         let lref: Vec<&[f64]> = locked.iter().map(|v| v.as_slice()).collect();
-        let mut nr = k_orthogonalize(ops, &lref, &mut r, &mut kr);
+        let lkref: Vec<&[f64]> = locked_k.iter().map(|v| v.as_slice()).collect();
+        let mut nr = k_orthogonalize(&lref, &lkref, &mut r, &mut kr);
         if !(nr.is_finite() && nr > 0.0) {
             // The random vector had no component outside the locked space / null space.
             restart += 1;
@@ -790,6 +805,7 @@ fn lanczos(
         loop {
             r.iter_mut().for_each(|v| *v /= nr);
             q.push(std::mem::take(&mut r));
+            z.push(kr.iter().map(|v| v / nr).collect());
             let j = q.len() - 1;
             // a = −K_G q_j ; r = K⁻¹ a ; α = q_jᵀ a
             ops.kg_mul(&q[j], &mut tmp);
@@ -800,12 +816,19 @@ fn lanczos(
             stats.operator_applications += 1;
             steps += 1;
             r = (0..n).map(|i| m[(i, 0)]).collect();
+            // K r = a exactly, carried through the orthogonalisation.
+            kr.copy_from_slice(&tmp);
             let basis: Vec<&[f64]> = lref
                 .iter()
                 .copied()
                 .chain(q.iter().map(|v| v.as_slice()))
                 .collect();
-            nr = k_orthogonalize(ops, &basis, &mut r, &mut kr);
+            let kbasis: Vec<&[f64]> = lkref
+                .iter()
+                .copied()
+                .chain(z.iter().map(|v| v.as_slice()))
+                .collect();
+            nr = k_orthogonalize(&basis, &kbasis, &mut r, &mut kr);
             let dim = q.len();
             let exhausted = dim >= m_max || steps >= max_steps;
             let scale = alpha.iter().map(|a| a.abs()).fold(0.0, f64::max);
