@@ -5,6 +5,7 @@
 
 mod cmd;
 mod output;
+mod report_input;
 
 use std::process::ExitCode;
 
@@ -32,6 +33,8 @@ enum Command {
     Design(cmd::design::DesignArgs),
     /// Write a commented example design file.
     Init(cmd::design::InitArgs),
+    /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
+    Study(cmd::study::StudyCommand),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Command::Robot(c) => cmd::robot::run(c),
         Command::Design(a) => cmd::design::run(a),
         Command::Init(a) => cmd::design::init(a),
+        Command::Study(c) => cmd::study::run(c),
     };
     match result {
         Ok(code) => code,

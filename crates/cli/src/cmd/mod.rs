@@ -4,3 +4,4 @@ pub mod cem;
 pub mod design;
 pub mod fe;
 pub mod robot;
+pub mod study;

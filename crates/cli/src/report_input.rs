@@ -1,0 +1,475 @@
+//! From a designed cap to the HTML report input (issue 8), and the pass/fail verdict of a design.
+//!
+//! [`report_input`] maps a [`kappe::Cap`] plus optional analysis and robot results
+//! ([`ReportExtras`], plain data the caller fills) to [`kappe_report::ReportInput`]:
+//!
+//! - `layers`: `cap.sections.layers` in print order; the final-state stress of segment `i` of the
+//!   layer at print index `q` is `σ = F_i · d_q / (lw·lh)` (method.md §3, §6: `F_i` the layer-0
+//!   force, `d_q` the layer factor of the final state); overhang `l_o` from `cap.overhangs`
+//!   (`None` for the first layer).
+//! - `bed_joints`: the final state's trail edges, `σ = N / (lw·l_trib)` with the trail forces of
+//!   the final force pass, drawn from the lower node to the upper one; a column's last edge ends
+//!   on the base plane.
+//! - `states`: one per `cap.states`, with σ_min/σ_max of the force pass, the largest |l_o| of the
+//!   printed layers and, while the page stays small, per-state segment stresses
+//!   `F_i · d_q(state) / (lw·lh)` (the factors of every state are rebuilt with
+//!   [`kappe::states::build_state`]; they differ from the final ones only in the start section).
+//! - `constraints`: [`preliminary_constraints`] (σ_min, σ_max, overhang, worst over all states),
+//!   then the analysis rows of [`ReportExtras::constraints`], which replace rows of the same
+//!   name and add new ones (BLF, robot reach, …).
+//!
+//! [`design_ok`] is the one place where a design's verdict is decided: `kappe design` (exit
+//! status) and `kappe study` (the pass/fail column) both call it, so they cannot disagree.
+//! [`analyse`] is the one place where the analysis joins the pipeline; today it returns no
+//! analysis and the verdict is the preliminary one.
+
+use kappe::Cap;
+use kappe_report::{
+    BedJoint, Bound, ConstraintRow, Layer, Parameter, Plot, PrintPath, PrintState, ReportInput,
+    RobotAnimation,
+};
+
+/// Relative tolerance on stress limits. The fixed-geometry force pass balances every node to
+/// ~1e-14 relative (method.md §9), so an arch whose forces are all compressive in exact
+/// arithmetic shows tensile stresses of ~1e-11 Pa from roundoff (observed 3e-11 Pa against
+/// 15 kPa of compression); without a tolerance σ_max = 0 would fail every design. 1e-9 of the
+/// largest stress magnitude is far above roundoff and far below any physical meaning.
+const STRESS_RELATIVE_TOLERANCE: f64 = 1e-9;
+
+/// Above this many per-state segment stresses in total, the states carry none and the viewer
+/// colours every state by the final-state stresses: the page grows by ~10 bytes per value,
+/// so this bounds the island at ~20 MB (the default design needs ~0.3 million).
+const MAX_STATE_STRESS_VALUES: usize = 2_000_000;
+
+/// Results of one print state from the analysis (`kappe::constraints::analyze` when it exists).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(
+    dead_code,
+    reason = "constructed by the analysis wiring of issue 8 (lead)"
+)]
+pub struct StateCheck {
+    /// Lowest positive linear buckling load factor of the state, if computed.
+    pub blf: Option<f64>,
+    /// Whether the state meets every structural constraint.
+    pub ok: bool,
+}
+
+/// What the analysis and the robot planner add to a designed cap. Plain data: the caller fills
+/// it; [`ReportExtras::default`] means "not analysed, no robot".
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReportExtras {
+    /// One entry per `cap.states` (same order), or empty when there is no analysis. An entry's
+    /// `ok` replaces the preliminary per-state verdict; its `blf` feeds the BLF plot.
+    pub states: Vec<StateCheck>,
+    /// Constraint rows of the analysis (worst over all states). A row replaces the preliminary
+    /// row of the same `name` (`sigma_min`, `sigma_max`, `overhang`); other rows are appended.
+    pub constraints: Vec<ConstraintRow>,
+    /// The analysis verdict over all constraints; `None` until the analysis exists.
+    pub ok: Option<bool>,
+    /// The robot moving along its trajectory.
+    pub robot: Option<RobotAnimation>,
+    /// Extra plots after the standard ones.
+    pub plots: Vec<Plot>,
+}
+
+/// The one place where the analysis joins the pipeline, for both `kappe design` and
+/// `kappe study`. Today there is no analysis crate yet, so nothing is added and [`design_ok`]
+/// falls back to the preliminary checks. When `kappe::constraints` lands, fill
+/// [`ReportExtras::states`], [`ReportExtras::constraints`] and [`ReportExtras::ok`] from
+/// `analyze(cap, ..)` here.
+pub fn analyse(_cap: &Cap) -> ReportExtras {
+    ReportExtras::default()
+}
+
+/// Whether the design passes: the analysis verdict when there is one, else every
+/// [`preliminary_constraints`] row holds (σ_min ≤ σ ≤ σ_max in every state and
+/// max |l_o| ≤ l_o,max). `kappe design` and `kappe study` both decide with this function.
+pub fn design_ok(cap: &Cap, extras: &ReportExtras) -> bool {
+    extras
+        .ok
+        .unwrap_or_else(|| preliminary_constraints(cap).iter().all(|c| c.pass))
+}
+
+/// Stress tolerance in Pa (see [`STRESS_RELATIVE_TOLERANCE`]).
+fn stress_tolerance(cap: &Cap) -> f64 {
+    let scale = cap
+        .states
+        .iter()
+        .map(|s| {
+            s.forces
+                .max_compression_stress
+                .abs()
+                .max(s.forces.max_tension_stress.abs())
+        })
+        .fold(0.0, f64::max);
+    STRESS_RELATIVE_TOLERANCE * scale
+}
+
+/// Largest |l_o| among the first `printed` layers (print order), m.
+fn max_overhang(cap: &Cap, printed: usize) -> f64 {
+    cap.overhangs
+        .iter()
+        .take(printed)
+        .fold(0.0, |m, o| m.max(o.abs()))
+}
+
+/// Preliminary per-state verdict: stresses within the limits and every printed layer's
+/// overhang within l_o,max.
+fn state_ok_preliminary(cap: &Cap, state: &kappe::StateSummary, tol: f64) -> bool {
+    let k = &cap.design.constraints;
+    state.forces.max_compression_stress >= k.sigma_min - tol
+        && state.forces.max_tension_stress <= k.sigma_max + tol
+        && max_overhang(cap, state.layers_printed) <= cap.design.overhang_max()
+}
+
+/// The constraints checkable without the finite-element analysis, worst value over all states:
+/// `sigma_min` (most compressive stress ≥ σ_min), `sigma_max` (largest stress ≤ σ_max), both
+/// in kPa, and `overhang` (max |l_o| ≤ l_o,max, mm).
+pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintRow> {
+    let k = &cap.design.constraints;
+    let tol = stress_tolerance(cap);
+    let mut worst_c: (f64, Option<usize>) = (0.0, None);
+    let mut worst_t: (f64, Option<usize>) = (f64::NEG_INFINITY, None);
+    for s in &cap.states {
+        if worst_c.1.is_none() || s.forces.max_compression_stress < worst_c.0 {
+            worst_c = (s.forces.max_compression_stress, Some(s.index));
+        }
+        if worst_t.1.is_none() || s.forces.max_tension_stress > worst_t.0 {
+            worst_t = (s.forces.max_tension_stress, Some(s.index));
+        }
+    }
+    let worst_t = if worst_t.1.is_none() {
+        (0.0, None)
+    } else {
+        worst_t
+    };
+    // The worst overhang is reached when its layer is printed: that state index is the layer's
+    // print index (state q = layers 0..=q printed).
+    let mut worst_o: (f64, Option<usize>) = (0.0, None);
+    for (q, o) in cap.overhangs.iter().enumerate() {
+        if worst_o.1.is_none() || o.abs() > worst_o.0 {
+            worst_o = (o.abs(), Some(q));
+        }
+    }
+    let layer_name = |q: usize| {
+        cap.sections
+            .layers
+            .get(q)
+            .map(|l| format!("layer {} over the layer before it", l.id))
+    };
+    let lo_max = cap.design.overhang_max();
+    vec![
+        ConstraintRow {
+            name: "sigma_min".into(),
+            bound: Bound::AtLeast,
+            limit: k.sigma_min / 1e3,
+            worst: worst_c.0 / 1e3,
+            unit: "kPa".into(),
+            state: worst_c.1,
+            element: None,
+            pass: worst_c.0 >= k.sigma_min - tol,
+        },
+        ConstraintRow {
+            name: "sigma_max".into(),
+            bound: Bound::AtMost,
+            limit: k.sigma_max / 1e3,
+            worst: worst_t.0 / 1e3,
+            unit: "kPa".into(),
+            state: worst_t.1,
+            element: None,
+            pass: worst_t.0 <= k.sigma_max + tol,
+        },
+        ConstraintRow {
+            name: "overhang".into(),
+            bound: Bound::AtMost,
+            limit: lo_max * 1e3,
+            worst: worst_o.0 * 1e3,
+            unit: "mm".into(),
+            state: worst_o.1,
+            element: worst_o.1.and_then(layer_name),
+            pass: worst_o.0 <= lo_max,
+        },
+    ]
+}
+
+/// The constraint table: preliminary rows, replaced or extended by the analysis rows.
+fn constraint_rows(cap: &Cap, extras: &ReportExtras) -> Vec<ConstraintRow> {
+    let mut rows = preliminary_constraints(cap);
+    for row in &extras.constraints {
+        match rows.iter_mut().find(|r| r.name == row.name) {
+            Some(slot) => *slot = row.clone(),
+            None => rows.push(row.clone()),
+        }
+    }
+    rows
+}
+
+fn v3(v: &kappe::frame::V3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn parameters(cap: &Cap) -> Vec<Parameter> {
+    let d = &cap.design;
+    let p = |key: &str, value: String, unit: &str| Parameter {
+        key: key.into(),
+        value,
+        unit: unit.into(),
+    };
+    let mut out = vec![
+        p("span Cs", format!("{}", d.cap.span), "m"),
+        p("rise Cr", format!("{}", d.cap.rise), "m"),
+        p("length Cl", format!("{}", d.cap.length), "m"),
+        p("layer tilt am", format!("{}", d.cap.tilt_deg), "deg"),
+        p(
+            "specific weight γ",
+            format!("{}", d.material.specific_weight),
+            "N/m³",
+        ),
+        p(
+            "Young's modulus E",
+            format!("{}", d.material.youngs_modulus / 1e6),
+            "MPa",
+        ),
+        p(
+            "Poisson's ratio ν",
+            format!("{}", d.material.poisson_ratio),
+            "",
+        ),
+        p(
+            "layer height lh",
+            format!("{}", d.print.layer_height * 1e3),
+            "mm",
+        ),
+        p(
+            "layer width lw",
+            format!("{}", d.print.layer_width * 1e3),
+            "mm",
+        ),
+        p(
+            "nozzle diameter d_n",
+            format!("{}", d.print.nozzle_diameter * 1e3),
+            "mm",
+        ),
+        p(
+            "path sampling Δs",
+            format!("{}", d.print.path_sampling * 1e3),
+            "mm",
+        ),
+        p(
+            "start-layer arch fraction φ",
+            format!("{}", d.print.start_arch_fraction),
+            "",
+        ),
+        p("print speed", format!("{}", d.print.print_speed), "m/s"),
+        p("σ_min", format!("{}", d.constraints.sigma_min / 1e3), "kPa"),
+        p("σ_max", format!("{}", d.constraints.sigma_max / 1e3), "kPa"),
+        p("BLF_min", format!("{}", d.constraints.blf_min), ""),
+        p("l_o,max", format!("{}", d.overhang_max() * 1e3), "mm"),
+    ];
+    out.extend([
+        p("centre layers N", format!("{}", cap.sections.n_centre), ""),
+        p("start layers K", format!("{}", cap.sections.n_start), ""),
+        p("catenary a", format!("{:.6}", cap.catenary.a), "m"),
+        p("mass", format!("{:.2}", cap.path.mass), "kg"),
+        p("print time", format!("{:.1}", cap.path.time / 60.0), "min"),
+    ]);
+    out
+}
+
+/// Per-state segment stresses: the printed layers' segments, concatenated in print order, with
+/// that state's layer factors. `None` when a state cannot be rebuilt (it was built once already
+/// by `design_cap`, so this does not happen for a finished cap) or the total is too large.
+fn state_segment_stresses(cap: &Cap, area: f64) -> Option<Vec<Vec<f64>>> {
+    let seg_counts: Vec<usize> = cap
+        .sections
+        .layers
+        .iter()
+        .map(|l| l.segment_forces.len())
+        .collect();
+    let total: usize = cap
+        .states
+        .iter()
+        .map(|s| seg_counts.iter().take(s.layers_printed).sum::<usize>())
+        .sum();
+    if total > MAX_STATE_STRESS_VALUES {
+        return None;
+    }
+    let phi = cap.design.print.start_arch_fraction;
+    cap.states
+        .iter()
+        .map(|s| {
+            let state = kappe::states::build_state(&cap.sections, &cap.frame, phi, s.index).ok()?;
+            let mut out = Vec::new();
+            for (layer, d) in cap.sections.layers.iter().zip(&state.factors) {
+                out.extend(layer.segment_forces.iter().map(|f| f * d / area));
+            }
+            Some(out)
+        })
+        .collect()
+}
+
+/// Maps a designed cap (plus optional analysis and robot results) to the report input.
+/// See the module docs for the mapping.
+pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
+    let d = &cap.design;
+    let areas = cap.areas();
+    let normal = v3(&cap.frame.n);
+    let final_factors = &cap.final_state.factors;
+
+    let layers: Vec<Layer> = cap
+        .sections
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(q, l)| {
+            let factor = final_factors.get(q).copied().unwrap_or(1.0);
+            Layer {
+                id: l.id,
+                nodes: l.nodes.iter().map(|n| v3(&n.xyz)).collect(),
+                segment_stress: l
+                    .segment_forces
+                    .iter()
+                    .map(|f| f * factor / areas.along_layer)
+                    .collect(),
+                plane_normal: normal,
+                bead_width: d.print.layer_width,
+                bead_height: d.print.layer_height,
+                overhang: if q == 0 {
+                    None
+                } else {
+                    cap.overhangs.get(q).copied()
+                },
+            }
+        })
+        .collect();
+
+    // Trails run from the top layer down to the base: `u` is the upper node, `v` the lower.
+    let net = &cap.final_state.network;
+    let bed_joints: Vec<BedJoint> = cap
+        .final_topology
+        .trail_edges
+        .iter()
+        .zip(&cap.final_forces.trail_forces)
+        .filter_map(|(e, f)| {
+            let upper = net.nodes.get(usize::try_from(e.u).ok()?)?;
+            let lower = net.nodes.get(usize::try_from(e.v).ok()?)?;
+            Some(BedJoint {
+                layer: upper.layer,
+                a: v3(&lower.xyz),
+                b: v3(&upper.xyz),
+                stress: f / areas.bed_joint,
+            })
+        })
+        .collect();
+
+    let print_path = PrintPath {
+        points: cap.path.points.iter().map(|p| v3(&p.tip)).collect(),
+        tool_axis: cap.path.points.iter().map(|p| v3(&p.axis)).collect(),
+        layer: cap.path.points.iter().map(|p| p.layer).collect(),
+    };
+
+    let tol = stress_tolerance(cap);
+    let mut per_state = state_segment_stresses(cap, areas.along_layer);
+    let states: Vec<PrintState> = cap
+        .states
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let check = extras.states.get(i);
+            PrintState {
+                index: s.index,
+                progress: s.progress.clamp(0.0, 1.0),
+                layers_printed: s.layers_printed,
+                blf: check.and_then(|c| c.blf),
+                sigma_min: s.forces.max_compression_stress,
+                sigma_max: s.forces.max_tension_stress,
+                max_overhang: max_overhang(cap, s.layers_printed),
+                ok: check.map_or_else(|| state_ok_preliminary(cap, s, tol), |c| c.ok),
+                segment_stress: per_state
+                    .as_mut()
+                    .and_then(|v| v.get_mut(i))
+                    .map(std::mem::take),
+            }
+        })
+        .collect();
+
+    ReportInput {
+        name: d.name.clone(),
+        parameters: parameters(cap),
+        layers,
+        bed_joints,
+        print_path,
+        states,
+        constraints: constraint_rows(cap, extras),
+        robot: extras.robot.clone(),
+        plots: extras.plots.clone(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cheap_cap() -> Cap {
+        // 3 centre layers and lh = 15 mm: a few start layers, a fast design.
+        let design =
+            kappe::Design::from_toml_str("[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n")
+                .unwrap();
+        kappe::design_cap(&design, &|_| {}).unwrap()
+    }
+
+    #[test]
+    fn input_validates_and_matches_the_cap() {
+        let cap = cheap_cap();
+        let input = report_input(&cap, &ReportExtras::default());
+        input.validate().unwrap();
+        assert_eq!(input.layers.len(), cap.sections.layers.len());
+        assert_eq!(input.states.len(), cap.states.len());
+        assert_eq!(input.print_path.points.len(), cap.path.points.len());
+        assert_eq!(input.bed_joints.len(), cap.final_topology.trail_edges.len());
+        // The last state is the final state: its per-state stresses equal the layers' ones.
+        let last = input.states.last().unwrap();
+        let from_layers: Vec<f64> = input
+            .layers
+            .iter()
+            .flat_map(|l| l.segment_stress.iter().copied())
+            .collect();
+        assert_eq!(last.segment_stress.as_deref(), Some(from_layers.as_slice()));
+        // The most compressive arch stress of the final state cannot be below the state's
+        // σ_min, which also covers the bed joints.
+        let min_arch = from_layers.iter().copied().fold(0.0, f64::min);
+        assert!(min_arch >= last.sigma_min);
+    }
+
+    #[test]
+    fn analysis_rows_replace_and_extend() {
+        let cap = cheap_cap();
+        let extras = ReportExtras {
+            states: vec![
+                StateCheck {
+                    blf: Some(3.0),
+                    ok: true
+                };
+                cap.states.len()
+            ],
+            constraints: vec![ConstraintRow {
+                name: "blf".into(),
+                bound: Bound::AtLeast,
+                limit: 1.0,
+                worst: 3.0,
+                unit: String::new(),
+                state: Some(0),
+                element: None,
+                pass: true,
+            }],
+            ok: Some(false),
+            ..ReportExtras::default()
+        };
+        let input = report_input(&cap, &extras);
+        let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["sigma_min", "sigma_max", "overhang", "blf"]);
+        assert!(input.states.iter().all(|s| s.blf == Some(3.0) && s.ok));
+        // The analysis verdict wins over the preliminary one.
+        assert!(!design_ok(&cap, &extras));
+    }
+}

@@ -1,0 +1,360 @@
+//! `kappe study`: a 3×3×3 grid against `kappe design` run on each design alone, shards merged
+//! against the unsharded study, and bad study files.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const KAPPE: &str = env!("CARGO_BIN_EXE_kappe");
+
+fn kappe(args: &[&str], cwd: &Path) -> Output {
+    Command::new(KAPPE)
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap()
+}
+
+/// A cheap base (3 centre layers of 15 mm, 13 states) and three axes chosen so that the grid
+/// holds designs that pass, that fail by stress (σ_min = −12 or −16 kPa against 15.4–17 kPa of
+/// arch compression), that fail by overhang (l_o,max = 10 mm against 20–25 mm in the start
+/// section) and that cannot run (l_o,max < 0 is out of range).
+const BASE: &str = "cap.length = 0.05\nprint.layer_height = 0.015\n";
+const OVERHANGS: [f64; 3] = [-0.005, 0.01, 0.03];
+const RISES: [f64; 3] = [0.15, 0.2, 0.3];
+const SIGMA_MINS: [f64; 3] = [-12e3, -16e3, -40e3];
+
+fn grid_study() -> String {
+    format!(
+        "title = \"grid\"\n[base]\n{BASE}[grid]\n\"constraints.overhang_max\" = {OVERHANGS:?}\n\
+         \"cap.rise\" = {RISES:?}\n\"constraints.sigma_min\" = {SIGMA_MINS:?}\n"
+    )
+}
+
+/// `study.csv` as rows of header → value.
+fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    lines
+        .map(|l| {
+            // The error column is last and may be quoted with commas inside: split the others.
+            let fields: Vec<&str> = l.splitn(header.len(), ',').collect();
+            header
+                .iter()
+                .cloned()
+                .zip(fields.iter().map(|s| s.to_string()))
+                .collect()
+        })
+        .collect()
+}
+
+/// The verdict of `kappe design` alone: it must exit 0, and its `summary.json` must meet the
+/// design's own limits (method.md §3): σ_min ≤ σ ≤ σ_max in every state, max |l_o| ≤ l_o,max
+/// (default lw/2). Stress limits get 1e-9 of the largest stress as slack: the force pass is
+/// exact to ~1e-14 relative, and an all-compression arch shows ~1e-11 Pa of roundoff tension.
+fn design_alone_passes(toml: &str, work: &Path, tag: &str) -> (bool, bool) {
+    let file = work.join(format!("{tag}.toml"));
+    std::fs::write(&file, toml).unwrap();
+    let out = work.join(tag);
+    let run = kappe(
+        &[
+            "design",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ],
+        work,
+    );
+    if !run.status.success() {
+        return (false, false);
+    }
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    let k = &s["design"]["constraints"];
+    let sigma_min = k["sigma_min"].as_f64().unwrap();
+    let sigma_max = k["sigma_max"].as_f64().unwrap();
+    let lo_max = k["overhang_max"]
+        .as_f64()
+        .unwrap_or(0.5 * s["design"]["print"]["layer_width"].as_f64().unwrap());
+    let states = s["states"].as_array().unwrap();
+    let comp = states
+        .iter()
+        .map(|x| x["max_compression_stress_pa"].as_f64().unwrap())
+        .fold(0.0, f64::min);
+    let tens = states
+        .iter()
+        .map(|x| x["max_tension_stress_pa"].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    let tol = 1e-9 * comp.abs().max(tens.abs());
+    let ok = comp >= sigma_min - tol
+        && tens <= sigma_max + tol
+        && s["max_overhang_m"].as_f64().unwrap() <= lo_max;
+    (true, ok)
+}
+
+#[test]
+fn grid_reproduces_kappe_design_row_by_row() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path();
+    std::fs::write(work.join("grid.toml"), grid_study()).unwrap();
+    let run = kappe(&["study", "grid.toml", "--out", "s", "--quiet"], work);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rows = read_csv(&work.join("s/study.csv"));
+    assert_eq!(rows.len(), 27);
+
+    // Every combination as its own design file, in the test's own words.
+    let mut combos = Vec::new();
+    for o in OVERHANGS {
+        for r in RISES {
+            for sm in SIGMA_MINS {
+                let toml = format!(
+                    "[cap]\nlength = 0.05\nrise = {r:?}\n[print]\nlayer_height = 0.015\n\
+                     [constraints]\nsigma_min = {sm:?}\noverhang_max = {o:?}\n"
+                );
+                combos.push(((o, r, sm), toml));
+            }
+        }
+    }
+    // `kappe design` on each alone, two processes at a time (the machine has 2 cores).
+    let alone: Vec<(bool, bool)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..2)
+            .map(|w| {
+                let combos = &combos;
+                scope.spawn(move || {
+                    (w..combos.len())
+                        .step_by(2)
+                        .map(|k| (k, design_alone_passes(&combos[k].1, work, &format!("d{k}"))))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut all: Vec<(usize, (bool, bool))> = workers
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect();
+        all.sort_by_key(|(k, _)| *k);
+        all.into_iter().map(|(_, v)| v).collect()
+    });
+
+    let mut seen = [0usize; 3]; // pass, fail, error
+    for (((o, r, sm), _), (ran, ok)) in combos.iter().zip(alone) {
+        // Find the row by its parameter values, not by the study's naming scheme.
+        let num = |row: &BTreeMap<String, String>, key: &str| -> f64 { row[key].parse().unwrap() };
+        let matching: Vec<&BTreeMap<String, String>> = rows
+            .iter()
+            .filter(|row| {
+                num(row, "constraints.overhang_max") == *o
+                    && num(row, "cap.rise") == *r
+                    && num(row, "constraints.sigma_min") == *sm
+            })
+            .collect();
+        assert_eq!(matching.len(), 1, "l_o,max {o} rise {r} σ_min {sm}");
+        let row = matching[0];
+        let result = row["result"].as_str();
+        assert_eq!(
+            result == "pass",
+            ok,
+            "row {} says {result}, kappe design alone says ok = {ok}",
+            row["name"]
+        );
+        // A design that cannot run is an error row, with its reason, and vice versa.
+        assert_eq!(result == "error", !ran, "row {}", row["name"]);
+        let report = work
+            .join("s/designs")
+            .join(&row["name"])
+            .join("report.html");
+        if ran {
+            assert!(report.is_file(), "{}", report.display());
+        } else {
+            assert!(
+                row["error"].contains("constraints.overhang_max"),
+                "{}",
+                row["error"]
+            );
+            assert!(!report.exists());
+        }
+        seen[match result {
+            "pass" => 0,
+            "fail" => 1,
+            _ => 2,
+        }] += 1;
+    }
+    // The grid was chosen to hold all three outcomes; if it stops doing so, this test would
+    // compare nothing interesting.
+    assert!(
+        seen.iter().all(|&n| n > 0),
+        "pass/fail/error counts {seen:?}"
+    );
+
+    // study.html: one row per design, a link to every report that exists.
+    let html = std::fs::read_to_string(work.join("s/study.html")).unwrap();
+    assert_eq!(html.matches("<tr class=").count(), 27);
+    assert_eq!(html.matches(">report</a>").count(), seen[0] + seen[1]);
+    assert!(html.contains("cell-fail"));
+}
+
+/// Every file under `dir`, relative path → bytes.
+fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(root, &p, out);
+            } else {
+                out.insert(
+                    p.strip_prefix(root).unwrap().to_path_buf(),
+                    std::fs::read(&p).unwrap(),
+                );
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk(dir, dir, &mut out);
+    out
+}
+
+#[test]
+fn shards_merged_equal_the_unsharded_study() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path();
+    std::fs::write(work.join("grid.toml"), grid_study()).unwrap();
+    let ok = |o: Output| {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        o
+    };
+    ok(kappe(&["study", "grid.toml", "--out", "all", "-q"], work));
+    // 27 designs in 4 shards: 7, 7, 7, 6; one shard on one thread.
+    for i in 0..4 {
+        let spec = format!("{i}/4");
+        let out = format!("part{i}");
+        let mut args = vec!["study", "grid.toml", "--shard", &spec, "--out", &out, "-q"];
+        if i == 2 {
+            args.extend(["--jobs", "1"]);
+        }
+        ok(kappe(&args, work));
+        let n = read_csv(&work.join(&out).join("study.csv")).len();
+        assert_eq!(n, if i < 3 { 7 } else { 6 }, "shard {i}");
+    }
+    // Shards given in any order.
+    ok(kappe(
+        &[
+            "study", "merge", "part3", "part1", "part0", "part2", "--out", "merged", "-q",
+        ],
+        work,
+    ));
+    let a = tree(&work.join("all"));
+    let b = tree(&work.join("merged"));
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "same files"
+    );
+    for (path, bytes) in &a {
+        assert!(b[path] == *bytes, "{} differs", path.display());
+    }
+
+    // A missing shard is an error naming the gap; --allow-incomplete merges what is there.
+    let missing = kappe(
+        &["study", "merge", "part0", "part1", "part2", "--out", "m2"],
+        work,
+    );
+    assert!(!missing.status.success());
+    let err = String::from_utf8_lossy(&missing.stderr);
+    assert!(err.contains("6 of 27 designs are missing"), "{err}");
+    assert!(!work.join("m2").exists());
+    ok(kappe(
+        &[
+            "study",
+            "merge",
+            "part0",
+            "part1",
+            "--out",
+            "m3",
+            "--allow-incomplete",
+            "-q",
+        ],
+        work,
+    ));
+    assert_eq!(read_csv(&work.join("m3/study.csv")).len(), 14);
+    // The same shard twice, and a shard of another study.
+    let twice = kappe(&["study", "merge", "part0", "part0", "--out", "m4"], work);
+    assert!(String::from_utf8_lossy(&twice.stderr).contains("is in both"));
+    std::fs::write(
+        work.join("other.toml"),
+        grid_study().replace("0.15, 0.2", "0.16, 0.2"),
+    )
+    .unwrap();
+    ok(kappe(
+        &[
+            "study",
+            "other.toml",
+            "--shard",
+            "1/4",
+            "--out",
+            "other1",
+            "-q",
+        ],
+        work,
+    ));
+    let mixed = kappe(&["study", "merge", "part0", "other1", "--out", "m5"], work);
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("different studies"));
+}
+
+#[test]
+fn bad_study_files_are_clear_errors_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path();
+    let cases: [(&str, &str, &[&str]); 6] = [
+        ("empty grid", "[grid]\n", &["[grid] table is empty"]),
+        (
+            "duplicate names",
+            "[[design]]\nname = \"a\"\n[[design]]\nname = \"b\"\n[[design]]\nname = \"a\"\n",
+            &["duplicate design name `a`", "#1", "#3"],
+        ),
+        (
+            "unknown parameter in a grid",
+            "[grid]\n\"cap.spam\" = [0.6, 0.8]\n",
+            &["grid entry `cap.spam`", "unknown field `spam`"],
+        ),
+        (
+            "unknown parameter in a list",
+            "[[design]]\nname = \"wide\"\ncap.span = 1.0\n[[design]]\nname = \"x\"\nprint.nozle = 0.02\n",
+            &["[[design]] #2 (`x`)", "`print.nozle`"],
+        ),
+        (
+            "wrong type",
+            "[grid]\n\"cap.rise\" = [\"high\"]\n",
+            &["grid entry `cap.rise`", "expected f64"],
+        ),
+        (
+            "empty list",
+            "[grid]\n\"cap.rise\" = []\n\"cap.span\" = [1.0]\n",
+            &["grid entry `cap.rise` is an empty list"],
+        ),
+    ];
+    for (what, text, needles) in cases {
+        std::fs::write(work.join("bad.toml"), text).unwrap();
+        let o = kappe(&["study", "bad.toml", "--out", "out"], work);
+        assert!(!o.status.success(), "{what}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        for n in needles {
+            assert!(err.contains(n), "{what}: {err}");
+        }
+        assert!(!work.join("out").exists(), "{what}: wrote output");
+    }
+    std::fs::write(work.join("ok.toml"), "[grid]\n\"cap.rise\" = [0.2]\n").unwrap();
+    for spec in ["4/4", "x", "1/0"] {
+        let o = kappe(&["study", "ok.toml", "--shard", spec, "--out", "out"], work);
+        assert!(!o.status.success(), "{spec}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(&format!("--shard `{spec}`")),
+            "{spec}"
+        );
+    }
+}
