@@ -70,6 +70,7 @@ fn a4_greenhill_heavy_column() {
         },
     )
     .unwrap();
+    println!("heavy column: {} vs {exact}", r.factors[0]);
     assert!(
         rel(r.factors[0], exact) < 0.01,
         "{} vs {exact}",
