@@ -88,6 +88,8 @@ pub struct BucklingOptions {
     pub seed: u64,
     /// Upper bound on Lanczos steps over all restarts (0 = automatic).
     pub max_steps: usize,
+    /// Largest Lanczos basis before a restart (0 = automatic: ~400 MB of vectors, 30…300).
+    pub max_basis: usize,
 }
 
 impl Default for BucklingOptions {
@@ -98,6 +100,7 @@ impl Default for BucklingOptions {
             sturm_check: true,
             seed: 0x006b_6170_7065,
             max_steps: 0,
+            max_basis: 0,
         }
     }
 }
@@ -739,7 +742,12 @@ fn lanczos(
 ) -> Result<Vec<Pair>, FeError> {
     let n = ops.pattern.n;
     // Memory cap on the basis Q and K·Q: ~400 MB, between 30 and 300 vectors each.
-    let m_cap = (25_000_000 / n.max(1)).clamp(30, 300).min(n);
+    let m_cap = if options.max_basis == 0 {
+        (25_000_000 / n.max(1)).clamp(30, 300)
+    } else {
+        options.max_basis.max(want + 2)
+    }
+    .min(n);
     let mut converged: Vec<Pair> = Vec::new();
     let mut steps = 0usize;
     let mut start: Option<Vec<f64>> = None;
