@@ -12,7 +12,7 @@
 //!   "drilling_alpha": 1e-3 }              // optional
 //! ```
 //! Self-weight γ·t per unit area acts whenever γ > 0, along `direction` of a `self_weight`
-//! load (default −z). Other keys (`name`, `units`, `description`, `geometry`, `note`) are
+//! load (default −z); γ may also be given inside the `self_weight` load (as the fixtures do). Other keys (`name`, `units`, `description`, `geometry`, `note`) are
 //! ignored.
 
 use serde_json::Value;
@@ -104,10 +104,27 @@ pub fn parse_mesh(text: &str) -> Result<ShellModel, FeError> {
     let thickness = scalar_or_list(get("thickness")?, "thickness")?;
     let e = scalar_or_list(get("E")?, "E")?;
     let nu = scalar_or_list(get("nu")?, "nu")?;
-    let gamma = match obj.get("gamma") {
-        Some(v) => scalar_or_list(v, "gamma")?,
-        None => vec![0.0],
+    // γ at the top level, or (fixture style) inside a self_weight load.
+    let load_gamma = obj.get("load").and_then(|l| match l {
+        Value::Array(a) => a
+            .iter()
+            .find(|x| x.get("type").and_then(Value::as_str) == Some("self_weight"))
+            .and_then(|x| x.get("gamma")),
+        _ => l.get("gamma"),
+    });
+    let gamma = match (obj.get("gamma"), load_gamma) {
+        (Some(v), _) => scalar_or_list(v, "gamma")?,
+        (None, Some(v)) => scalar_or_list(v, "load.gamma")?,
+        (None, None) => vec![0.0],
     };
+    if let (Some(top), Some(inner)) = (obj.get("gamma"), load_gamma)
+        && top != inner
+    {
+        return Err(fmt_err(
+            "load.gamma",
+            format!("{inner} differs from the top-level gamma {top}; give one of them"),
+        ));
+    }
     let n_el = triangles.len();
     let n_mat = [e.len(), nu.len(), gamma.len()]
         .into_iter()

@@ -147,3 +147,19 @@ fn json_errors_name_the_field() {
     assert!(e.to_string().contains("nodes[0][2]"), "{e}");
     assert!(parse_mesh("not json").is_err());
 }
+
+/// γ given only inside the self_weight load is used; conflicting values are rejected.
+#[test]
+fn gamma_in_load() {
+    let base = "\"nodes\": [[0,0,0],[1,0,0],[0,1,0]], \"triangles\": [[0,1,2]], \"thickness\": 0.1, \"E\": 1e6, \"nu\": 0.3";
+    let m = parse_mesh(&format!(
+        "{{{base}, \"load\": {{\"type\": \"self_weight\", \"gamma\": 5.0}}}}"
+    ))
+    .unwrap();
+    assert_eq!(m.materials[0].unit_weight, 5.0);
+    let e = parse_mesh(&format!(
+        "{{{base}, \"gamma\": 4.0, \"load\": {{\"type\": \"self_weight\", \"gamma\": 5.0}}}}"
+    ))
+    .unwrap_err();
+    assert!(e.to_string().contains("load.gamma"), "{e}");
+}
