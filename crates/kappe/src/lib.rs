@@ -8,7 +8,9 @@
 
 pub mod analysis;
 pub mod arch;
+pub mod calibrate;
 pub mod constraints;
+pub mod design_loop;
 pub mod error;
 pub mod export;
 pub mod forces;
