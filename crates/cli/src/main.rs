@@ -35,6 +35,10 @@ enum Command {
     Init(cmd::design::InitArgs),
     /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
     Study(cmd::study::StudyCommand),
+    /// Derive BLF_min (or the effective E) from printed prototypes that stood or failed.
+    Calibrate(cmd::calibrate::CalibrateArgs),
+    /// The design loop: vary the free parameters within bounds to meet every constraint with the least material.
+    Optimize(cmd::optimize::OptimizeArgs),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +50,8 @@ fn main() -> ExitCode {
         Command::Design(a) => cmd::design::run(a),
         Command::Init(a) => cmd::design::init(a),
         Command::Study(c) => cmd::study::run(c),
+        Command::Calibrate(a) => cmd::calibrate::run(a),
+        Command::Optimize(a) => cmd::optimize::run(a),
     };
     match result {
         Ok(code) => code,

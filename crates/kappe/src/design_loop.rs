@@ -118,6 +118,59 @@ impl OptimizeFile {
         Ok(file)
     }
 
+    /// Read either an optimize file (top-level `free`) or a design file with an `[optimize]`
+    /// table holding the optimize fields (`free`, `analysis`, `verify`, `max_evaluations`); the
+    /// rest of such a file is the starting design, returned alongside.
+    ///
+    /// ```
+    /// let text = "[cap]\nrise = 0.25\n[optimize.free]\n\"cap.rise\" = { min = 0.15, max = 0.3 }\n";
+    /// let (file, design) = kappe::design_loop::OptimizeFile::from_any_toml_str(text).unwrap();
+    /// assert_eq!(design.unwrap().cap.rise, 0.25);
+    /// assert_eq!(file.parameters().unwrap()[0].name, "cap.rise");
+    /// ```
+    pub fn from_any_toml_str(text: &str) -> Result<(OptimizeFile, Option<Design>), DesignError> {
+        let mut table: toml::Table =
+            text.parse()
+                .map_err(|e: toml::de::Error| DesignError::Parse {
+                    path: String::new(),
+                    message: e.to_string().trim().to_string(),
+                })?;
+        let Some(opt) = table.remove("optimize") else {
+            return Ok((OptimizeFile::from_toml_str(text)?, None));
+        };
+        let toml::Value::Table(opt) = opt else {
+            return Err(DesignError::Parse {
+                path: "optimize".into(),
+                message: "expected a table [optimize]".into(),
+            });
+        };
+        if opt.contains_key("design") {
+            return Err(DesignError::Parse {
+                path: "optimize.design".into(),
+                message: "not allowed inside a design file: the file itself is the design".into(),
+            });
+        }
+        let ser = |t: &toml::Table| {
+            toml::to_string(t).map_err(|e| DesignError::Parse {
+                path: String::new(),
+                message: e.to_string(),
+            })
+        };
+        let design = Design::from_toml_str(&ser(&table)?)?;
+        let file = OptimizeFile::from_toml_str(&ser(&opt)?).map_err(|e| match e {
+            DesignError::Parse { path, message } => DesignError::Parse {
+                path: if path.is_empty() {
+                    "optimize".into()
+                } else {
+                    format!("optimize.{path}")
+                },
+                message,
+            },
+            other => other,
+        })?;
+        Ok((file, Some(design)))
+    }
+
     /// The free parameters, checked: known name, both bounds, finite, min < max.
     pub fn parameters(&self) -> Result<Vec<FreeParameter>, DesignError> {
         if self.free.is_empty() {

@@ -1,7 +1,9 @@
 //! One module per subcommand group.
 
+pub mod calibrate;
 pub mod cem;
 pub mod design;
 pub mod fe;
+pub mod optimize;
 pub mod robot;
 pub mod study;
