@@ -62,7 +62,8 @@ pub struct ReportExtras {
     /// `ok` replaces the preliminary per-state verdict; its `blf` feeds the BLF plot.
     pub states: Vec<StateCheck>,
     /// Constraint rows of the analysis (worst over all states). A row replaces the preliminary
-    /// row of the same `name` (`sigma_min`, `sigma_max`, `overhang`); other rows are appended.
+    /// row of the same `name` (`sigma_min`, `sigma_max`, `overhang_max`); other rows (`blf_min`,
+    /// robot checks) are appended.
     pub constraints: Vec<ConstraintRow>,
     /// The analysis verdict over all constraints; `None` until the analysis exists.
     pub ok: Option<bool>,
@@ -73,12 +74,91 @@ pub struct ReportExtras {
 }
 
 /// The one place where the analysis joins the pipeline, for both `kappe design` and
-/// `kappe study`. Today there is no analysis crate yet, so nothing is added and [`design_ok`]
-/// falls back to the preliminary checks. When `kappe::constraints` lands, fill
-/// [`ReportExtras::states`], [`ReportExtras::constraints`] and [`ReportExtras::ok`] from
-/// `analyze(cap, ..)` here.
-pub fn analyse(_cap: &Cap) -> ReportExtras {
-    ReportExtras::default()
+/// `kappe study`: with `options`, the finite-element analysis of `kappe::constraints::analyze`
+/// (per-state BLF and verdict, the constraint table, the overall verdict); without, nothing is
+/// added and [`design_ok`] decides on the preliminary checks (stresses and overhang).
+///
+/// # Errors
+/// What `analyze` returns (invalid options, a state that cannot be rebuilt).
+pub fn analyse(
+    cap: &Cap,
+    options: Option<&kappe::constraints::AnalysisOptions>,
+) -> Result<ReportExtras, kappe::DesignError> {
+    match options {
+        None => Ok(ReportExtras::default()),
+        Some(o) => Ok(extras_from_analysis(&kappe::constraints::analyze(
+            cap,
+            o,
+            &|_| {},
+        )?)),
+    }
+}
+
+/// The analysis of `kappe::constraints::analyze` as report extras: per-state BLF and verdict,
+/// the constraint rows in the report's units (stresses in kPa, overhang in mm; the analysis
+/// gives Pa and m), and the overall verdict. A constraint that no state was checked for (e.g.
+/// `blf_min` with buckling switched off) has no worst value and is left out of the table.
+#[allow(
+    dead_code,
+    reason = "called from `analyse` once the analysis is switched on (lead)"
+)]
+pub fn extras_from_analysis(analysis: &kappe::constraints::Analysis) -> ReportExtras {
+    let states = analysis
+        .states
+        .iter()
+        .map(|s| StateCheck {
+            blf: s.blf,
+            ok: s.ok,
+        })
+        .collect();
+    let constraints = analysis
+        .constraints
+        .iter()
+        .filter_map(|c| {
+            let worst = c.worst?;
+            let (scale, unit) = match c.unit {
+                "Pa" => (1e-3, "kPa"),
+                "m" => (1e3, "mm"),
+                "1" => (1.0, ""),
+                other => (1.0, other),
+            };
+            let bound = match c.name {
+                "sigma_max" | "overhang_max" => Bound::AtMost,
+                _ => Bound::AtLeast,
+            };
+            Some(ConstraintRow {
+                name: c.name.to_string(),
+                bound,
+                limit: c.limit * scale,
+                worst: worst * scale,
+                unit: unit.to_string(),
+                state: c.state,
+                element: (!c.element.is_empty()).then(|| c.element.clone()),
+                pass: c.pass,
+            })
+        })
+        .collect();
+    ReportExtras {
+        states,
+        constraints,
+        ok: Some(analysis.ok),
+        ..ReportExtras::default()
+    }
+}
+
+/// The arm posed along the robot plan (`kappe::robot_plan::arm_frames`) as the report's
+/// animation.
+#[allow(
+    dead_code,
+    reason = "called by `kappe design` once the report is wired in (lead)"
+)]
+pub fn robot_animation(frames: &kappe::robot_plan::ArmFrames) -> RobotAnimation {
+    RobotAnimation {
+        times: frames.times.clone(),
+        joints: frames.joints.clone(),
+        link_radii: frames.radii.clone(),
+        poses: frames.segments.clone(),
+    }
 }
 
 /// Whether the design passes: the analysis verdict when there is one, else every
@@ -124,7 +204,8 @@ fn state_ok_preliminary(cap: &Cap, state: &kappe::StateSummary, tol: f64) -> boo
 
 /// The constraints checkable without the finite-element analysis, worst value over all states:
 /// `sigma_min` (most compressive stress ≥ σ_min), `sigma_max` (largest stress ≤ σ_max), both
-/// in kPa, and `overhang` (max |l_o| ≤ l_o,max, mm).
+/// in kPa, and `overhang_max` (max |l_o| ≤ l_o,max, mm). The names are those of
+/// `kappe::constraints::analyze`, so its rows replace these.
 pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintRow> {
     let k = &cap.design.constraints;
     let tol = stress_tolerance(cap);
@@ -180,7 +261,7 @@ pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintRow> {
             pass: worst_t.0 <= k.sigma_max + tol,
         },
         ConstraintRow {
-            name: "overhang".into(),
+            name: "overhang_max".into(),
             bound: Bound::AtMost,
             limit: lo_max * 1e3,
             worst: worst_o.0 * 1e3,
@@ -467,9 +548,55 @@ mod tests {
         };
         let input = report_input(&cap, &extras);
         let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
-        assert_eq!(names, ["sigma_min", "sigma_max", "overhang", "blf"]);
+        assert_eq!(names, ["sigma_min", "sigma_max", "overhang_max", "blf"]);
         assert!(input.states.iter().all(|s| s.blf == Some(3.0) && s.ok));
         // The analysis verdict wins over the preliminary one.
         assert!(!design_ok(&cap, &extras));
+    }
+
+    #[test]
+    fn the_analysis_replaces_the_preliminary_rows_and_agrees_with_them() {
+        let cap = cheap_cap();
+        let options = kappe::constraints::AnalysisOptions {
+            // Stresses and overhang only: the FE buckling solve is tested in crates/kappe.
+            buckling: false,
+            ..Default::default()
+        };
+        let analysis = kappe::constraints::analyze(&cap, &options, &|_| {}).unwrap();
+        let extras = extras_from_analysis(&analysis);
+        assert_eq!(extras.states.len(), cap.states.len());
+        let input = report_input(&cap, &extras);
+        input.validate().unwrap();
+        // blf_min was checked in no state, so it has no row; the other three replace the
+        // preliminary rows and must agree with them in verdict, limit and worst value.
+        let pre = preliminary_constraints(&cap);
+        assert_eq!(input.constraints.len(), pre.len());
+        for (a, p) in input.constraints.iter().zip(&pre) {
+            assert_eq!(
+                (a.name.as_str(), a.pass, a.bound),
+                (p.name.as_str(), p.pass, p.bound)
+            );
+            assert_eq!(a.unit, p.unit);
+            assert!(
+                (a.limit - p.limit).abs() <= 1e-12 * p.limit.abs().max(1.0),
+                "{a:?} {p:?}"
+            );
+            // Both take the extreme over all states of the same force pass: equal to roundoff.
+            assert!(
+                (a.worst - p.worst).abs() <= 1e-9 * p.worst.abs().max(1e-6),
+                "{a:?} {p:?}"
+            );
+        }
+        assert_eq!(
+            design_ok(&cap, &extras),
+            design_ok(&cap, &ReportExtras::default())
+        );
+        for (s, p) in input
+            .states
+            .iter()
+            .zip(&report_input(&cap, &ReportExtras::default()).states)
+        {
+            assert_eq!(s.ok, p.ok, "state {}", s.index);
+        }
     }
 }

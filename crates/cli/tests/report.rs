@@ -163,7 +163,7 @@ fn report_input_matches_closed_forms_and_the_summary() {
     // Constraint table: σ_min, σ_max, overhang with the design's limits; their verdict is the
     // study's.
     let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
-    assert_eq!(names, ["sigma_min", "sigma_max", "overhang"]);
+    assert_eq!(names, ["sigma_min", "sigma_max", "overhang_max"]);
     assert_eq!(input.constraints[0].limit, -20.0);
     assert_eq!(input.constraints[2].limit, 15.0);
     let all_pass = input.constraints.iter().all(|c| c.pass);
@@ -203,7 +203,7 @@ fn failed_constraints_are_marked_in_the_report() {
         [
             ("sigma_min", false),
             ("sigma_max", true),
-            ("overhang", false)
+            ("overhang_max", false)
         ]
     );
     // The worst overhang is in the start section: a layer with a negative id.

@@ -310,7 +310,12 @@ fn shards_merged_equal_the_unsharded_study() {
 fn bad_study_files_are_clear_errors_and_write_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let work = tmp.path();
-    let cases: [(&str, &str, &[&str]); 6] = [
+    let cases: [(&str, &str, &[&str]); 7] = [
+        (
+            "bad analysis options",
+            "[analysis]\nstate = \"all\"\n[[design]]\nname = \"a\"\n",
+            &["[analysis]", "unknown field `state`"],
+        ),
         ("empty grid", "[grid]\n", &["[grid] table is empty"]),
         (
             "duplicate names",
@@ -357,4 +362,47 @@ fn bad_study_files_are_clear_errors_and_write_nothing() {
             "{spec}"
         );
     }
+}
+
+#[test]
+fn an_analysis_table_adds_the_buckling_factor() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path();
+    // "every:1000" analyses state 0 (one layer on the bed: no shell, no factor) and the final
+    // state: one finite-element solve, so the test stays quick.
+    std::fs::write(
+        work.join("a.toml"),
+        "[analysis]\nstates = \"every:1000\"\n[[design]]\nname = \"a\"\n\
+         cap.length = 0.05\nprint.layer_height = 0.015\nconstraints.overhang_max = 0.03\n",
+    )
+    .unwrap();
+    let run = kappe(&["study", "a.toml", "--out", "s", "-q"], work);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rows = read_csv(&work.join("s/study.csv"));
+    let blf: f64 = rows[0]["min_blf"].parse().unwrap();
+    assert!(blf > 0.0);
+    // The report's table has the BLF row, at the final state, with the design's BLF_min = 1.
+    let html = std::fs::read_to_string(work.join("s/designs/a/report.html")).unwrap();
+    let start = html.find("id=\"kappe-data\">").unwrap() + "id=\"kappe-data\">".len();
+    let len = html[start..].find("</script>").unwrap();
+    let input: serde_json::Value = serde_json::from_str(&html[start..start + len]).unwrap();
+    let rows = input["constraints"].as_array().unwrap();
+    let row = rows.iter().find(|r| r["name"] == "blf_min").unwrap();
+    let states = input["states"].as_array().unwrap();
+    assert_eq!(row["limit"], 1.0);
+    assert_eq!(row["state"], states.len() - 1);
+    assert_eq!(row["pass"], blf >= 1.0);
+    // The island keeps 7 significant digits.
+    assert!((row["worst"].as_f64().unwrap() - blf).abs() <= 1e-6 * blf);
+    let with_blf: Vec<usize> = states
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| !s["blf"].is_null())
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(with_blf, [states.len() - 1]);
 }

@@ -22,6 +22,11 @@
 //! in a design file (a study error, naming the entry), while a value outside its allowed range
 //! makes only that design fail (a row marked failed with the reason).
 //!
+//! An optional `[analysis]` table (the options of `kappe::constraints::analyze`, e.g.
+//! `states = "25%"`, `buckling = false`, `modes = 3`) runs the finite-element analysis on every
+//! design, adding the BLF and its verdict; without it designs are judged on stresses and
+//! overhang only (the preliminary checks of [`crate::report_input::preliminary_constraints`]).
+//!
 //! Grid axes are taken in the alphabetical order of their paths, the last varying fastest;
 //! grid designs are named `<field>=<value>` joined by `_` (e.g. `rise=0.15_span=0.6`).
 //!
@@ -140,8 +145,11 @@ struct Study {
     /// Varied parameter paths: the table's parameter columns.
     parameters: Vec<String>,
     variations: Vec<Variation>,
-    /// FNV-1a over every design's name and input: shards of one study share it.
+    /// FNV-1a over the analysis options and every design's name and input: shards of one
+    /// study share it.
     fingerprint: String,
+    /// Options of the finite-element analysis, if the study asks for it.
+    analysis: Option<kappe::constraints::AnalysisOptions>,
 }
 
 /// Flattens nested tables into dotted paths, so that `"cap.span" = 1` and `cap.span = 1` (or
@@ -288,10 +296,10 @@ fn base_table(doc: &toml::Table, study_dir: &Path) -> Result<toml::Table> {
 fn parse_study(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
     let doc: toml::Table = text.parse().context("the study file is not valid TOML")?;
     for key in doc.keys() {
-        if !["title", "base", "grid", "design"].contains(&key.as_str()) {
+        if !["title", "base", "grid", "design", "analysis"].contains(&key.as_str()) {
             bail!(
                 "unknown key `{key}` in the study file; allowed: title, base, grid (a table), \
-                 design (a [[design]] list)"
+                 design (a [[design]] list), analysis (a table)"
             );
         }
     }
@@ -301,6 +309,17 @@ fn parse_study(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
         Some(other) => bail!("`title` must be a string, not a {}", other.type_str()),
     };
     let base = base_table(&doc, study_dir)?;
+    let analysis = match doc.get("analysis") {
+        None => None,
+        Some(v) => {
+            let o: kappe::constraints::AnalysisOptions = v
+                .clone()
+                .try_into()
+                .map_err(|e: toml::de::Error| anyhow!("[analysis]: {}", e.message()))?;
+            o.validate().context("[analysis]")?;
+            Some(o)
+        }
+    };
 
     // (name, overrides) in study order, and the parameter columns.
     let (parameters, entries): Entries = match (doc.get("grid"), doc.get("design")) {
@@ -327,6 +346,8 @@ fn parse_study(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
     }
 
     let mut hash = 0xcbf2_9ce4_8422_2325_u64;
+    let options = serde_json::to_string(&analysis).unwrap_or_default();
+    hash = fnv1a(options.as_bytes(), hash);
     let mut variations = Vec::with_capacity(entries.len());
     for (index, (name, overrides)) in entries.into_iter().enumerate() {
         let mut table = base.clone();
@@ -351,6 +372,7 @@ fn parse_study(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
         parameters,
         variations,
         fingerprint: format!("{hash:016x}"),
+        analysis,
     })
 }
 
@@ -587,7 +609,12 @@ fn failed_record(v: &Variation, parameters: Vec<String>, reason: String) -> Reco
 }
 
 /// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
-fn run_one(v: &Variation, parameter_paths: &[String], root: &Path) -> Record {
+fn run_one(
+    v: &Variation,
+    parameter_paths: &[String],
+    analysis: Option<&kappe::constraints::AnalysisOptions>,
+    root: &Path,
+) -> Record {
     let parameters: Vec<String> = parameter_paths
         .iter()
         .map(|p| {
@@ -622,7 +649,7 @@ fn run_one(v: &Variation, parameter_paths: &[String], root: &Path) -> Record {
     };
     let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| -> Result<Record> {
         let cap = kappe::design_cap(design, &|_| {})?;
-        let extras = analyse(&cap);
+        let extras = analyse(&cap, analysis)?;
         let ok = design_ok(&cap, &extras);
         let input = report_input(&cap, &extras);
         let html = kappe_report::render_html(&input).context("cannot render the report")?;
@@ -912,7 +939,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
             selected
                 .par_iter()
                 .map(|v| {
-                    let r = run_one(v, &study.parameters, dir);
+                    let r = run_one(v, &study.parameters, study.analysis.as_ref(), dir);
                     bar.inc(1);
                     r
                 })
