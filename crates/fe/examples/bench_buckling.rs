@@ -2,7 +2,7 @@
 //! meshes of the fixture family (`generate::barrel_vault`), ~10⁴ and ~10⁵ nodes. Prints a
 //! markdown table (wall times per phase, nnz, operator applications, peak RSS).
 //!
-//! `cargo run --release -p kappe-fe --example bench_buckling [-- small|large|all]`
+//! `cargo run --release -p kappe-fe --example bench_buckling [-- all|small|large|small-sturm|large-nosturm|…]`
 //! Targets (buckling.md §4): 10⁴ nodes ≤ 2 s, 10⁵ nodes ≤ 30 s and ≤ 2 GB, on 2 cores.
 
 use std::time::Instant;
@@ -61,15 +61,19 @@ fn main() -> Result<(), FeError> {
         "| nodes | free DOFs | Sturm | nnz(K) | nnz(L) | symbolic s | assembly s | factor+static s | stresses+K_G s | Lanczos s | Sturm s | K⁻¹K_G applications | total s | peak RSS MB | λ₁, λ₂, λ₃ |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    if which == "small" || which == "all" {
-        // 131 × 77 = 10 087 nodes.
-        run(130, 76, false)?;
-        run(130, 76, true)?;
-    }
-    if which == "large" || which == "all" {
-        // 411 × 244 = 100 284 nodes.
-        run(410, 243, false)?;
-        run(410, 243, true)?;
+    // Each configuration can run in its own process (`small-sturm`, `large-nosturm`, …) so
+    // the peak RSS column is not the high-water mark of an earlier run.
+    let cases = [
+        ("small", 130, 76),  // 131 × 77 = 10 087 nodes
+        ("large", 410, 243), // 411 × 244 = 100 284 nodes
+    ];
+    for (name, na, nl) in cases {
+        for sturm in [false, true] {
+            let tag = format!("{name}-{}", if sturm { "sturm" } else { "nosturm" });
+            if which == "all" || which == name || which == tag {
+                run(na, nl, sturm)?;
+            }
+        }
     }
     Ok(())
 }

@@ -88,7 +88,7 @@ pub struct BucklingOptions {
     pub seed: u64,
     /// Upper bound on Lanczos steps over all restarts (0 = automatic).
     pub max_steps: usize,
-    /// Largest Lanczos basis before a restart (0 = automatic: ~400 MB of vectors, 30…300).
+    /// Largest Lanczos basis before a restart (0 = automatic: ~320 MB of vectors, 30…300).
     pub max_basis: usize,
 }
 
@@ -274,7 +274,7 @@ impl BucklingSolver {
         let t1 = Instant::now();
         let n = self.dofs.n_free();
         let kdiag = self.diagonal(&kvals);
-        let llt = match self.symbolic.llt(&kvals) {
+        let llt = match self.symbolic.llt(&self.pattern, &kvals) {
             Ok(l) => l,
             Err(LltFailure::NotPositive(idx)) => {
                 return Err(self.mechanism(&kvals, &kdiag, idx));
@@ -404,7 +404,7 @@ impl BucklingSolver {
                 }
             }
         }
-        let Ok(llt) = self.symbolic.llt(&reg) else {
+        let Ok(llt) = self.symbolic.llt(&self.pattern, &reg) else {
             return fallback();
         };
         let n = p.n;
@@ -541,7 +541,7 @@ impl BucklingSolver {
                 // Deflated restart: the Krylov space is kept K-orthogonal to the found modes,
                 // so it converges to the missed (e.g. repeated) factors.
                 let locked: Vec<Vec<f64>> = found.iter().map(|p| p.vector.clone()).collect();
-                let llt = match self.symbolic.llt(&kvals) {
+                let llt = match self.symbolic.llt(&self.pattern, &kvals) {
                     Ok(l) => l,
                     Err(LltFailure::NotPositive(idx)) => {
                         return Err(self.mechanism(&kvals, &self.diagonal(&kvals), idx));
@@ -605,7 +605,7 @@ impl BucklingSolver {
         let mut s = sigma;
         for _ in 0..4 {
             let vals: Vec<f64> = k.iter().zip(kg).map(|(a, b)| a + s * b).collect();
-            if let Some(neg) = self.symbolic.negative_pivots(&vals)? {
+            if let Some(neg) = self.symbolic.negative_pivots(&self.pattern, &vals)? {
                 return Ok((s, neg));
             }
             s *= 1.0 + 1e-5;
@@ -741,9 +741,9 @@ fn lanczos(
     stats: &mut SolveStats,
 ) -> Result<Vec<Pair>, FeError> {
     let n = ops.pattern.n;
-    // Memory cap on the basis Q and K·Q: ~400 MB, between 30 and 300 vectors each.
+    // Memory cap on the basis Q and K·Q: ~320 MB, between 30 and 300 vectors each.
     let m_cap = if options.max_basis == 0 {
-        (25_000_000 / n.max(1)).clamp(30, 300)
+        (20_000_000 / n.max(1)).clamp(30, 300)
     } else {
         options.max_basis.max(want + 2)
     }
