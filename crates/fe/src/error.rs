@@ -89,7 +89,7 @@ pub enum FeError {
     /// same way (a flipped, i.e. inverted, triangle in an otherwise consistently oriented mesh).
     #[error(
         "triangle {element} is inverted relative to triangle {neighbour}: both traverse edge \
-         {a}→{b} in the same direction (orient all triangles consistently)"
+         {a}→{b} in the same direction (orient all triangles consistently, or set allow_mixed_orientation / --allow-mixed-orientation: results are orientation-independent)"
     )]
     InvertedTriangle {
         /// Element index.

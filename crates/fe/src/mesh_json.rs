@@ -9,7 +9,8 @@
 //!   "load": {"type": "self_weight", "direction": [0, 0, -1]}
 //!        |  {"type": "nodal_forces", "forces": [[node, [fx, fy, fz]], [node, [fx, fy, fz, mx, my, mz]]]}
 //!        |  [ ...several of these... ],
-//!   "drilling_alpha": 1e-3 }              // optional
+//!   "drilling_alpha": 1e-3,                // optional
+//!   "allow_mixed_orientation": false }     // optional
 //! ```
 //! Self-weight γ·t per unit area acts whenever γ > 0, along `direction` of a `self_weight`
 //! load (default −z); γ may also be given inside the `self_weight` load (as the fixtures do). Other keys (`name`, `units`, `description`, `geometry`, `note`) are
@@ -257,6 +258,11 @@ pub fn parse_mesh(text: &str) -> Result<ShellModel, FeError> {
     model.nodal_loads = nodal_loads;
     if let Some(a) = obj.get("drilling_alpha") {
         model.drilling_alpha = num(a, "drilling_alpha")?;
+    }
+    if let Some(a) = obj.get("allow_mixed_orientation") {
+        model.allow_mixed_orientation = a
+            .as_bool()
+            .ok_or_else(|| fmt_err("allow_mixed_orientation", "expected true or false"))?;
     }
     Ok(model)
 }

@@ -81,6 +81,11 @@ pub struct ShellModel {
     /// Drilling spring factor α: k = α·E·t·A on each node's local θz (default 1e-3,
     /// see buckling.md §2 item 5: α ∈ [1e-6, 1e-2] moves λ₁ by < 0.1 %).
     pub drilling_alpha: f64,
+    /// Accept triangles whose orientation disagrees with their neighbours (default `false`:
+    /// such a triangle is reported as inverted). The element is orientation-independent
+    /// (acceptance check A10), so results do not change; only the local frames of the element
+    /// results (top/bottom stresses) then follow each triangle's own normal.
+    pub allow_mixed_orientation: bool,
 }
 
 /// Longest edge / smallest height above which a triangle is rejected as degenerate. Grid
@@ -104,6 +109,7 @@ impl ShellModel {
             gravity: [0.0, 0.0, -1.0],
             nodal_loads: Vec::new(),
             drilling_alpha: 1.0e-3,
+            allow_mixed_orientation: false,
         }
     }
 
@@ -140,8 +146,9 @@ impl ShellModel {
     ///
     /// Checks: finite numbers; node indices in range; every node used; thickness > 0,
     /// E > 0, −1 < ν < 0.5, γ ≥ 0; no degenerate triangle (repeated nodes, zero area, aspect
-    /// ratio > [`MAX_ASPECT`]); consistent orientation across shared edges (an inverted
-    /// triangle traverses a shared edge in the same direction as its neighbour).
+    /// ratio > [`MAX_ASPECT`]); unless `allow_mixed_orientation`, consistent orientation
+    /// across shared edges (an inverted triangle traverses a shared edge in the same direction
+    /// as its neighbour).
     pub fn validate(&self) -> Result<(), FeError> {
         let n_nodes = self.nodes.len();
         let n_el = self.triangles.len();
@@ -301,6 +308,9 @@ impl ShellModel {
         }
         if let Some(node) = used.iter().position(|u| !u) {
             return Err(FeError::UnreferencedNode { node });
+        }
+        if self.allow_mixed_orientation {
+            return Ok(());
         }
         // Orientation: in a consistently oriented mesh every directed edge occurs at most once.
         let mut directed: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * n_el);

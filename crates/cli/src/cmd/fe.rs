@@ -37,6 +37,9 @@ pub struct BuckleArgs {
     /// Skip the Sturm-count check (saves one factorization).
     #[arg(long)]
     no_sturm: bool,
+    /// Accept triangles oriented against their neighbours (results are orientation-independent).
+    #[arg(long)]
+    allow_mixed_orientation: bool,
 }
 
 #[derive(Args)]
@@ -46,6 +49,10 @@ pub struct StaticArgs {
     /// Output file (written atomically); stdout when absent.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Accept triangles oriented against their neighbours (results are orientation-independent;
+    /// element frames then follow each triangle's own normal).
+    #[arg(long)]
+    allow_mixed_orientation: bool,
 }
 
 pub fn run(cmd: FeCommand) -> Result<ExitCode> {
@@ -55,10 +62,13 @@ pub fn run(cmd: FeCommand) -> Result<ExitCode> {
     }
 }
 
-fn load(path: &Path) -> Result<ShellModel> {
+fn load(path: &Path, allow_mixed_orientation: bool) -> Result<ShellModel> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))
+    let mut model =
+        parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))?;
+    model.allow_mixed_orientation |= allow_mixed_orientation;
+    Ok(model)
 }
 
 fn emit(output: Option<&Path>, doc: &Value) -> Result<()> {
@@ -83,7 +93,7 @@ fn static_summary(s: &StaticResult) -> Value {
 
 fn buckle(args: BuckleArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let model = load(&args.mesh)?;
+    let model = load(&args.mesh, args.allow_mixed_orientation)?;
     let source = args.mesh.display().to_string();
     let options = BucklingOptions {
         modes: args.modes,
@@ -129,7 +139,7 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
 
 fn statics(args: StaticArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let model = load(&args.mesh)?;
+    let model = load(&args.mesh, args.allow_mixed_orientation)?;
     let source = args.mesh.display().to_string();
     let r = kappe_fe::linear_static(&model)
         .with_context(|| format!("static analysis of {source} failed"))?;

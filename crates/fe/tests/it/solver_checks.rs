@@ -164,6 +164,20 @@ fn a10_invariances() {
     let mut f = m.clone();
     f.triangles = m.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect();
     check(&f, "orientation flip");
+    // Mixed orientation (every third triangle reversed) is rejected by default and, when
+    // allowed, gives the same factors.
+    let mut mixed = m.clone();
+    for (e, t) in mixed.triangles.iter_mut().enumerate() {
+        if e % 3 == 0 {
+            *t = [t[0], t[2], t[1]];
+        }
+    }
+    assert!(matches!(
+        buckling(&mixed, &opts(1)),
+        Err(kappe_fe::FeError::InvertedTriangle { .. })
+    ));
+    mixed.allow_mixed_orientation = true;
+    check(&mixed, "mixed orientation");
     for alpha in [1e-6, 1e-2] {
         let mut a = m.clone();
         a.drilling_alpha = alpha;
