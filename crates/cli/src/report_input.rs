@@ -69,6 +69,9 @@ pub struct ReportExtras {
     pub ok: Option<bool>,
     /// The robot moving along its trajectory.
     pub robot: Option<RobotAnimation>,
+    /// Why the robot cannot print the design, if planning was tried and failed (the design then
+    /// fails, as `kappe design` exits non-zero for it).
+    pub robot_error: Option<String>,
     /// Extra plots after the standard ones.
     pub plots: Vec<Plot>,
 }
@@ -146,12 +149,12 @@ pub fn extras_from_analysis(analysis: &kappe::constraints::Analysis) -> ReportEx
     }
 }
 
+/// Frames of the robot animation embedded in the report, spread evenly over the plan: every
+/// waypoint would make the page large (~1 kB per frame for the 13 capsules of arm and tool).
+pub const ROBOT_FRAMES: usize = 600;
+
 /// The arm posed along the robot plan (`kappe::robot_plan::arm_frames`) as the report's
 /// animation.
-#[allow(
-    dead_code,
-    reason = "called by `kappe design` once the report is wired in (lead)"
-)]
 pub fn robot_animation(frames: &kappe::robot_plan::ArmFrames) -> RobotAnimation {
     RobotAnimation {
         times: frames.times.clone(),
@@ -161,13 +164,57 @@ pub fn robot_animation(frames: &kappe::robot_plan::ArmFrames) -> RobotAnimation 
     }
 }
 
+/// Adds the outcome of robot planning (`kappe::robot_plan::plan_robot`): for a plan, the
+/// animation ([`ROBOT_FRAMES`] frames) and a passing `robot_plan` row whose element tells the
+/// stations and the minimum clearance; for a failure, [`ReportExtras::robot_error`] and a
+/// failing row whose element is the planner's reason.
+pub fn add_robot(
+    extras: &mut ReportExtras,
+    plan: &Result<kappe_robot::Plan, kappe_robot::RobotError>,
+) {
+    let (pass, element) = match plan {
+        Ok(p) => {
+            // A plan that cannot be posed for the animation is still a valid plan: the page then
+            // shows no robot, and the verdict does not change.
+            extras.robot = kappe::robot_plan::arm_frames(p, &p.setup.tool, ROBOT_FRAMES)
+                .ok()
+                .map(|f| robot_animation(&f));
+            (
+                true,
+                format!(
+                    "{} station(s), min clearance {:.1} mm, {:.1} min",
+                    p.stations.len(),
+                    p.min_clearance * 1e3,
+                    p.total_time / 60.0
+                ),
+            )
+        }
+        Err(e) => {
+            extras.robot_error = Some(e.to_string());
+            (false, e.to_string())
+        }
+    };
+    extras.constraints.push(ConstraintRow {
+        name: "robot_plan".into(),
+        bound: Bound::AtMost,
+        limit: 0.0,
+        worst: if pass { 0.0 } else { 1.0 },
+        unit: "failures".into(),
+        state: None,
+        element: Some(element),
+        pass,
+    });
+}
+
 /// Whether the design passes: the analysis verdict when there is one, else every
 /// [`preliminary_constraints`] row holds (σ_min ≤ σ ≤ σ_max in every state and
-/// max |l_o| ≤ l_o,max). `kappe design` and `kappe study` both decide with this function.
+/// max |l_o| ≤ l_o,max); and the robot could be planned, if planning was tried
+/// ([`add_robot`]). `kappe design` and `kappe study` both decide with this function.
 pub fn design_ok(cap: &Cap, extras: &ReportExtras) -> bool {
-    extras
-        .ok
-        .unwrap_or_else(|| preliminary_constraints(cap).iter().all(|c| c.pass))
+    extras.robot_error.is_none()
+        && extras
+            .ok
+            .unwrap_or_else(|| preliminary_constraints(cap).iter().all(|c| c.pass))
 }
 
 /// Stress tolerance in Pa (see [`STRESS_RELATIVE_TOLERANCE`]).

@@ -163,14 +163,27 @@ fn report_input_matches_closed_forms_and_the_summary() {
     // Constraint table: σ_min, σ_max, overhang with the design's limits; their verdict is the
     // study's.
     let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
-    assert_eq!(names, ["sigma_min", "sigma_max", "overhang_max"]);
+    assert_eq!(
+        names,
+        ["sigma_min", "sigma_max", "overhang_max", "robot_plan"]
+    );
     assert_eq!(input.constraints[0].limit, -20.0);
     assert_eq!(input.constraints[2].limit, 15.0);
     let all_pass = input.constraints.iter().all(|c| c.pass);
     assert!(all_pass, "{:?}", input.constraints);
     let csv = std::fs::read_to_string(work.join("s/study.csv")).unwrap();
     assert!(csv.lines().nth(1).unwrap().contains(",pass,"), "{csv}");
-    assert!(html.contains("PASS: all 3 constraints met"));
+    assert!(html.contains("PASS: all 4 constraints met"));
+    // The robot was planned (the design's default) and is animated: one capsule pose per
+    // radius per frame, at most ROBOT_FRAMES (600) frames.
+    let robot = input.robot.as_ref().unwrap();
+    assert!(!robot.times.is_empty() && robot.times.len() <= 600);
+    assert!(
+        robot
+            .poses
+            .iter()
+            .all(|p| p.len() == robot.link_radii.len())
+    );
 }
 
 #[test]
@@ -203,12 +216,13 @@ fn failed_constraints_are_marked_in_the_report() {
         [
             ("sigma_min", false),
             ("sigma_max", true),
-            ("overhang_max", false)
+            ("overhang_max", false),
+            ("robot_plan", true)
         ]
     );
     // The worst overhang is in the start section: a layer with a negative id.
     let element = input.constraints[2].element.clone().unwrap();
     assert!(element.starts_with("layer -"), "{element}");
     assert!(input.states.iter().any(|s| !s.ok));
-    assert!(html.contains("FAIL: 2 of 3 constraints violated"));
+    assert!(html.contains("FAIL: 2 of 4 constraints violated"));
 }

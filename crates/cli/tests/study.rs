@@ -31,28 +31,46 @@ fn grid_study() -> String {
     )
 }
 
+/// One CSV line split into fields (RFC 4180 quoting: `"a, ""b"""` is `a, "b"`).
+fn csv_fields(line: &str) -> Vec<String> {
+    let mut out = vec![String::new()];
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                chars.next();
+                out.last_mut().unwrap().push('"');
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(String::new()),
+            (c, _) => out.last_mut().unwrap().push(c),
+        }
+    }
+    out
+}
+
 /// `study.csv` as rows of header → value.
 fn read_csv(path: &Path) -> Vec<BTreeMap<String, String>> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let header = csv_fields(lines.next().unwrap());
     lines
         .map(|l| {
-            // The error column is last and may be quoted with commas inside: split the others.
-            let fields: Vec<&str> = l.splitn(header.len(), ',').collect();
-            header
-                .iter()
-                .cloned()
-                .zip(fields.iter().map(|s| s.to_string()))
-                .collect()
+            let fields = csv_fields(l);
+            assert_eq!(fields.len(), header.len(), "{l}");
+            header.iter().cloned().zip(fields).collect()
         })
         .collect()
 }
 
-/// The verdict of `kappe design` alone: it must exit 0, and its `summary.json` must meet the
-/// design's own limits (method.md §3): σ_min ≤ σ ≤ σ_max in every state, max |l_o| ≤ l_o,max
-/// (default lw/2). Stress limits get 1e-9 of the largest stress as slack: the force pass is
-/// exact to ~1e-14 relative, and an all-compression arch shows ~1e-11 Pa of roundoff tension.
+/// `kappe design` alone: `(ran, ok)`. It ran if it wrote its outputs; it passes if it exits 0
+/// and its `summary.json` meets the design's own limits (method.md §3): σ_min ≤ σ ≤ σ_max in
+/// every state, max |l_o| ≤ l_o,max (default lw/2), and the robot was planned if it was tried.
+/// (Today `kappe design` exits non-zero only for a robot failure; when it also does so for a
+/// failed constraint, the exit status alone will carry the verdict and the checks below agree.)
+/// Stress limits get 1e-9 of the largest stress as slack: the force pass is exact to ~1e-14
+/// relative, and an all-compression arch shows ~1e-11 Pa of roundoff tension.
 fn design_alone_passes(toml: &str, work: &Path, tag: &str) -> (bool, bool) {
     let file = work.join(format!("{tag}.toml"));
     std::fs::write(&file, toml).unwrap();
@@ -67,11 +85,11 @@ fn design_alone_passes(toml: &str, work: &Path, tag: &str) -> (bool, bool) {
         ],
         work,
     );
-    if !run.status.success() {
+    let Ok(bytes) = std::fs::read(out.join("summary.json")) else {
+        assert!(!run.status.success(), "exit 0 without outputs");
         return (false, false);
-    }
-    let s: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    };
+    let s: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
     let k = &s["design"]["constraints"];
     let sigma_min = k["sigma_min"].as_f64().unwrap();
     let sigma_max = k["sigma_max"].as_f64().unwrap();
@@ -88,9 +106,11 @@ fn design_alone_passes(toml: &str, work: &Path, tag: &str) -> (bool, bool) {
         .map(|x| x["max_tension_stress_pa"].as_f64().unwrap())
         .fold(0.0, f64::max);
     let tol = 1e-9 * comp.abs().max(tens.abs());
-    let ok = comp >= sigma_min - tol
+    let ok = run.status.success()
+        && comp >= sigma_min - tol
         && tens <= sigma_max + tol
-        && s["max_overhang_m"].as_f64().unwrap() <= lo_max;
+        && s["max_overhang_m"].as_f64().unwrap() <= lo_max
+        && s["robot"]["ok"].as_bool() != Some(false);
     (true, ok)
 }
 
@@ -228,12 +248,25 @@ fn shards_merged_equal_the_unsharded_study() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         o
     };
-    ok(kappe(&["study", "grid.toml", "--out", "all", "-q"], work));
+    // The robot is not what shards are about: skip planning to keep the test quick.
+    ok(kappe(
+        &["study", "grid.toml", "--out", "all", "-q", "--no-robot"],
+        work,
+    ));
     // 27 designs in 4 shards: 7, 7, 7, 6; one shard on one thread.
     for i in 0..4 {
         let spec = format!("{i}/4");
         let out = format!("part{i}");
-        let mut args = vec!["study", "grid.toml", "--shard", &spec, "--out", &out, "-q"];
+        let mut args = vec![
+            "study",
+            "grid.toml",
+            "--shard",
+            &spec,
+            "--out",
+            &out,
+            "-q",
+            "--no-robot",
+        ];
         if i == 2 {
             args.extend(["--jobs", "1"]);
         }
@@ -299,10 +332,26 @@ fn shards_merged_equal_the_unsharded_study() {
             "--out",
             "other1",
             "-q",
+            "--no-robot",
         ],
         work,
     ));
     let mixed = kappe(&["study", "merge", "part0", "other1", "--out", "m5"], work);
+    assert!(String::from_utf8_lossy(&mixed.stderr).contains("different studies"));
+    // The same study with the robot planned is another study too.
+    ok(kappe(
+        &[
+            "study",
+            "grid.toml",
+            "--shard",
+            "1/4",
+            "--out",
+            "robot1",
+            "-q",
+        ],
+        work,
+    ));
+    let mixed = kappe(&["study", "merge", "part0", "robot1", "--out", "m6"], work);
     assert!(String::from_utf8_lossy(&mixed.stderr).contains("different studies"));
 }
 
@@ -376,7 +425,7 @@ fn an_analysis_table_adds_the_buckling_factor() {
          cap.length = 0.05\nprint.layer_height = 0.015\nconstraints.overhang_max = 0.03\n",
     )
     .unwrap();
-    let run = kappe(&["study", "a.toml", "--out", "s", "-q"], work);
+    let run = kappe(&["study", "a.toml", "--out", "s", "-q", "--no-robot"], work);
     assert!(
         run.status.success(),
         "{}",

@@ -63,7 +63,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::output::write_dir_atomic;
-use crate::report_input::{analyse, design_ok, report_input};
+use crate::report_input::{add_robot, analyse, design_ok, report_input};
 
 /// `kappe study`: run a study file, or merge shards.
 #[derive(Args)]
@@ -96,6 +96,10 @@ struct RunArgs {
     /// Number of designs run at the same time (default: one per core).
     #[arg(long, short)]
     jobs: Option<usize>,
+    /// Skip robot motion planning (as `kappe design --no-robot`): designs are then judged
+    /// without it.
+    #[arg(long)]
+    no_robot: bool,
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
@@ -566,6 +570,8 @@ struct Record {
     mass_kg: Option<f64>,
     print_time_s: Option<f64>,
     states: Option<usize>,
+    /// `ok` or `failed: <reason>` when the robot was planned.
+    robot: Option<String>,
     /// The design's constraint table (the report's).
     constraints: Vec<ConstraintRow>,
     /// Relative link to the design's report.
@@ -603,18 +609,23 @@ fn failed_record(v: &Variation, parameters: Vec<String>, reason: String) -> Reco
         mass_kg: None,
         print_time_s: None,
         states: None,
+        robot: None,
         constraints: Vec::new(),
         report: None,
     }
 }
 
 /// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
-fn run_one(
-    v: &Variation,
-    parameter_paths: &[String],
-    analysis: Option<&kappe::constraints::AnalysisOptions>,
-    root: &Path,
-) -> Record {
+/// What is run for every design besides `design_cap`.
+#[derive(Debug, Clone, Copy)]
+struct Steps<'a> {
+    /// The finite-element analysis, if the study asks for it.
+    analysis: Option<&'a kappe::constraints::AnalysisOptions>,
+    /// Plan the robot (for designs with `robot.enabled`), as `kappe design` does.
+    robot: bool,
+}
+
+fn run_one(v: &Variation, parameter_paths: &[String], steps: Steps, root: &Path) -> Record {
     let parameters: Vec<String> = parameter_paths
         .iter()
         .map(|p| {
@@ -649,7 +660,14 @@ fn run_one(
     };
     let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| -> Result<Record> {
         let cap = kappe::design_cap(design, &|_| {})?;
-        let extras = analyse(&cap, analysis)?;
+        let mut extras = analyse(&cap, steps.analysis)?;
+        let robot = if steps.robot && cap.design.robot.enabled {
+            let plan = kappe::robot_plan::plan_robot(&cap);
+            add_robot(&mut extras, &plan);
+            Some(extras.robot_error.clone())
+        } else {
+            None
+        };
         let ok = design_ok(&cap, &extras);
         let input = report_input(&cap, &extras);
         let html = kappe_report::render_html(&input).context("cannot render the report")?;
@@ -684,6 +702,7 @@ fn run_one(
             mass_kg: Some(cap.path.mass),
             print_time_s: Some(cap.path.time),
             states: Some(cap.states.len()),
+            robot: robot.map(|e| e.map_or_else(|| "ok".into(), |e| format!("failed: {e}"))),
             constraints: input.constraints,
             report: Some(format!("designs/{}/report.html", v.name)),
         })
@@ -741,6 +760,7 @@ fn study_csv(result: &StudyResult) -> String {
             "mass_kg",
             "print_time_s",
             "states",
+            "robot",
             "error",
         ]
         .map(String::from),
@@ -758,6 +778,7 @@ fn study_csv(result: &StudyResult) -> String {
         f.push(csv_num(r.mass_kg));
         f.push(csv_num(r.print_time_s));
         f.push(r.states.map(|n| n.to_string()).unwrap_or_default());
+        f.push(csv_field(r.robot.as_deref().unwrap_or("")));
         f.push(csv_field(r.error.as_deref().unwrap_or("")));
         s.push_str(&f.join(","));
         s.push('\n');
@@ -932,6 +953,10 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         }
         builder.build().context("cannot start the worker threads")?
     };
+    let steps = Steps {
+        analysis: study.analysis.as_ref(),
+        robot: !args.no_robot,
+    };
     let mut result = None;
     write_dir_atomic(&out, |dir| {
         std::fs::create_dir_all(dir.join("designs"))?;
@@ -939,7 +964,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
             selected
                 .par_iter()
                 .map(|v| {
-                    let r = run_one(v, &study.parameters, study.analysis.as_ref(), dir);
+                    let r = run_one(v, &study.parameters, steps, dir);
                     bar.inc(1);
                     r
                 })
@@ -949,7 +974,12 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
             format: RESULT_FORMAT.into(),
             version: 1,
             title: study.title.clone(),
-            fingerprint: study.fingerprint.clone(),
+            // Shards run with and without the robot must not be merged.
+            fingerprint: if args.no_robot {
+                format!("{}-no-robot", study.fingerprint)
+            } else {
+                study.fingerprint.clone()
+            },
             designs: study.variations.iter().map(|v| v.name.clone()).collect(),
             shard: shard.map(|(i, n)| [i, n]),
             parameters: study.parameters.clone(),
