@@ -332,6 +332,30 @@ impl ShellModel {
     }
 }
 
+/// Aspect ratio above which [`ShellModel::quality_warnings`] flags a triangle (buckling.md §2
+/// "Pitfalls": very flat triangles, aspect > 20, lose accuracy but are still solved).
+pub const WARN_ASPECT: f64 = 20.0;
+
+impl ShellModel {
+    /// Triangles with aspect ratio (longest edge / smallest height) above [`WARN_ASPECT`], as
+    /// `(element, aspect)`. They are solved, but CST/DKT accuracy degrades; refine or re-mesh.
+    pub fn quality_warnings(&self) -> Vec<(usize, f64)> {
+        self.triangles
+            .iter()
+            .enumerate()
+            .filter_map(|(e, t)| {
+                let p = [
+                    *self.nodes.get(t[0])?,
+                    *self.nodes.get(t[1])?,
+                    *self.nodes.get(t[2])?,
+                ];
+                let (_, aspect) = area_and_aspect(&p);
+                (aspect > WARN_ASPECT).then_some((e, aspect))
+            })
+            .collect()
+    }
+}
+
 /// Area and aspect ratio (longest edge / smallest height = longest edge² / (2·area)).
 pub(crate) fn area_and_aspect(p: &[[f64; 3]; 3]) -> (f64, f64) {
     let d = |a: [f64; 3], b: [f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];

@@ -83,6 +83,17 @@ fn emit(output: Option<&Path>, doc: &Value) -> Result<()> {
     }
 }
 
+/// Flat triangles (aspect > 20) are solved but flagged, with the worst few named.
+fn quality(model: &ShellModel) -> Value {
+    let mut w = model.quality_warnings();
+    w.sort_by(|a, b| b.1.total_cmp(&a.1));
+    json!({
+        "flat_triangles": w.len(),
+        "aspect_limit": kappe_fe::model::WARN_ASPECT,
+        "worst": w.iter().take(10).map(|(e, a)| json!({"element": e, "aspect": a})).collect::<Vec<_>>(),
+    })
+}
+
 fn static_summary(s: &StaticResult) -> Value {
     json!({
         "max_displacement": s.max_displacement,
@@ -112,6 +123,7 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
         "dofs": s.n_free_dofs,
         "time_s": time_s,
         "residuals": r.residuals,
+        "mesh_quality": quality(&model),
         "sturm": r.sturm.map(|c| json!({
             "sigma": c.sigma,
             "negative_pivots": c.negative_pivots,
@@ -167,6 +179,7 @@ fn statics(args: StaticArgs) -> Result<ExitCode> {
     let doc = json!({
         "static": static_summary(&r),
         "dofs": r.n_free_dofs,
+        "mesh_quality": quality(&model),
         "time_s": t0.elapsed().as_secs_f64(),
         "displacements": r.displacements,
         "reactions": reactions,

@@ -163,3 +163,16 @@ fn gamma_in_load() {
     .unwrap_err();
     assert!(e.to_string().contains("load.gamma"), "{e}");
 }
+
+/// A flat but valid triangle (longest edge 1 m, height 0.01 m: aspect 100) is accepted and
+/// flagged; a regular grid has no warnings.
+#[test]
+fn flat_triangles_are_flagged() {
+    assert!(square().quality_warnings().is_empty());
+    let nodes = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, 0.01, 0.0]];
+    let m = ShellModel::new(nodes, vec![[0, 1, 2]], 0.01, material(1e6, 0.3, 0.0));
+    let w = m.quality_warnings();
+    assert_eq!(w.len(), 1);
+    assert!((w[0].1 - 100.0).abs() < 1e-9, "{w:?}");
+    assert!(m.validate().is_ok());
+}
