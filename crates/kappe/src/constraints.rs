@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::DesignError;
 use crate::forces::{Sections2D, state_forces};
 use crate::pipeline::Cap;
-use crate::shell::{NoShell, ShellMaterial, state_shell};
+use crate::shell::{NoShell, ShellMaterial, StateShell, state_shell};
 use crate::states::{Role, State, build_state};
 
 /// Relative tolerance on stress limits (see the module docs).
@@ -584,6 +584,16 @@ pub fn state_buckling(
             });
         }
     };
+    shell_buckling(&shell, state.index, options)
+}
+
+/// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
+/// errors). A mechanism is reported with the layers of the free DOFs, not as an error.
+pub fn shell_buckling(
+    shell: &StateShell,
+    state: usize,
+    options: &AnalysisOptions,
+) -> Result<StateBuckling, DesignError> {
     let fe_opts = kappe_fe::BucklingOptions {
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
@@ -641,7 +651,7 @@ pub fn state_buckling(
             })
         }
         Err(e) => Err(DesignError::State {
-            state: state.index,
+            state,
             message: format!("buckling analysis failed: {e}"),
         }),
     }
