@@ -112,7 +112,8 @@ pub struct SturmCheck {
     pub sigma: f64,
     /// Negative pivots of LDLᵀ(K + σ K_G) = number of factors in (0, σ).
     pub negative_pivots: usize,
-    /// Returned factors ≤ σ.
+    /// Factors found ≤ σ (equal to `negative_pivots` on success; may exceed the number
+    /// returned when a factor at the cut-off is repeated).
     pub found_below: usize,
 }
 
@@ -517,10 +518,12 @@ impl BucklingSolver {
         let t2 = Instant::now();
         let mut sturm = None;
         if options.sturm_check && !found.is_empty() {
+            // σ just above the largest returned factor; the count at this fixed σ is computed
+            // once, and missing factors below it are searched until the counts agree.
+            let lam_max = found.iter().map(|p| p.lambda).fold(0.0, f64::max);
+            let (sigma, neg) = self.sturm_count(&kvals, &kg, lam_max * (1.0 + 1e-4))?;
             let mut rounds = 0;
             loop {
-                let lam_max = found.iter().map(|p| p.lambda).fold(0.0, f64::max);
-                let (sigma, neg) = self.sturm_count(&kvals, &kg, lam_max * (1.0 + 1e-4))?;
                 let below = found.iter().filter(|p| p.lambda <= sigma).count();
                 sturm = Some(SturmCheck {
                     sigma,
@@ -531,7 +534,7 @@ impl BucklingSolver {
                     break;
                 }
                 rounds += 1;
-                if neg < below || rounds > 4 {
+                if neg < below || rounds > 3 {
                     return Err(FeError::SturmMismatch {
                         sigma,
                         negative: neg,
@@ -566,7 +569,6 @@ impl BucklingSolver {
                 }
                 found.extend(extra);
                 found.sort_by(|a, b| a.lambda.total_cmp(&b.lambda));
-                found.truncate(k.max(neg));
             }
             found.truncate(k);
         }

@@ -65,8 +65,8 @@ fn a12_dense_cross_check() {
 }
 
 /// Repeated eigenvalues: square SS plate under equal biaxial compression; the (1,2) and
-/// (2,1) modes coincide (the mesh is symmetric under x ↔ y). Single-vector Lanczos finds one
-/// copy; the Sturm check must detect the second and the deflated restart must find it.
+/// (2,1) modes coincide (the mesh is symmetric under x ↔ y). When the requested count cuts
+/// the pair, the Sturm check must detect the second copy and the deflated restart find it.
 /// Checked against the dense pencil (1e-8).
 #[test]
 fn repeated_factors_found_via_sturm() {
@@ -97,6 +97,12 @@ fn repeated_factors_found_via_sturm() {
         rel(dense[1], dense[2]) < 1e-9,
         "expected a double factor: {dense:?}"
     );
+    // Asking for 2 modes cuts the count inside the double factor: Lanczos returns one copy,
+    // the Sturm count at 1.0001·λ₂ is 3, and the deflated restart must find the other copy.
+    let two = buckling(&m, &opts(2)).unwrap();
+    let c = two.sturm.unwrap();
+    assert_eq!((c.negative_pivots, c.found_below), (3, 3));
+    assert!(rel(two.factors[1], dense[1]) < 1e-8);
     let r = buckling(&m, &opts(3)).unwrap();
     for i in 0..3 {
         assert!(
