@@ -72,7 +72,7 @@ pub struct Resultants {
 }
 
 /// A 3-node flat shell element (6 DOF/node).
-pub trait ShellElement: Sync {
+pub trait ShellElement: Send + Sync {
     /// Global elastic stiffness `Tᵀ K_local T`.
     fn stiffness(&self, g: &TriangleGeometry, t: f64, m: &Material, drilling_alpha: f64) -> Mat18;
     /// Resultants from the element's 18 global displacements.

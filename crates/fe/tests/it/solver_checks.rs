@@ -268,3 +268,14 @@ fn restarted_lanczos_matches_dense() {
     }
     assert!(r.stats.operator_applications > 8);
 }
+
+/// The analysis engineer runs print states in parallel: solver, model and results must be
+/// shareable across threads.
+#[test]
+fn types_are_send_and_sync() {
+    fn check<T: Send + Sync>() {}
+    check::<BucklingSolver>();
+    check::<ShellModel>();
+    check::<kappe_fe::BucklingResult>();
+    check::<kappe_fe::FeError>();
+}
