@@ -845,7 +845,13 @@ fn lanczos(
             let breakdown = nr.is_nan() || nr <= 1e-12 * scale.max(f64::MIN_POSITIVE);
             if exhausted || breakdown || (dim >= want.min(m_max) && dim.is_multiple_of(check_every))
             {
-                let (theta, s) = tridiag_eigen(&alpha, &beta);
+                let Some((theta, s)) = tridiag_eigen(&alpha, &beta) else {
+                    return Err(FeError::NoConvergence {
+                        iterations: steps,
+                        detail: "the Lanczos tridiagonal eigenproblem failed (non-finite entries)"
+                            .into(),
+                    });
+                };
                 // Positive Ritz values, largest first; values below 1e-10 of the spectral
                 // radius are null-space round-off, not compressive modes.
                 let radius = theta.iter().map(|t| t.abs()).fold(0.0, f64::max);
@@ -923,7 +929,7 @@ fn lanczos(
 }
 
 /// Eigen-decomposition of the symmetric tridiagonal matrix (α on the diagonal, β below).
-fn tridiag_eigen(alpha: &[f64], beta: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
+fn tridiag_eigen(alpha: &[f64], beta: &[f64]) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let m = alpha.len();
     let t = DMatrix::from_fn(m, m, |i, j| {
         if i == j {
@@ -936,8 +942,10 @@ fn tridiag_eigen(alpha: &[f64], beta: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
             0.0
         }
     });
-    let e = SymmetricEigen::new(t);
-    (e.eigenvalues.iter().copied().collect(), e.eigenvectors)
+    // Bounded iterations: non-finite input (which validation should exclude) must end in an
+    // error, not an endless QR sweep.
+    let e = SymmetricEigen::try_new(t, f64::EPSILON, 1000 * m.max(1))?;
+    Some((e.eigenvalues.iter().copied().collect(), e.eigenvectors))
 }
 
 /// Ritz vector `Q s_i` (K-normalised since Q is K-orthonormal and s_i has unit norm).
