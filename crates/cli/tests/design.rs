@@ -15,7 +15,7 @@ fn design_writes_every_output_and_init_round_trips() {
     // A short cap keeps the test quick.
     let text = std::fs::read_to_string(&toml)
         .unwrap()
-        .replace("length = 0.6 ", "length = 0.1 ");
+        .replace("length = 0.6 ", "length = 0.15 ");
     std::fs::write(&toml, text).unwrap();
     let out = dir.path().join("out");
     let o = kappe()
@@ -24,6 +24,8 @@ fn design_writes_every_output_and_init_round_trips() {
         .arg("--out")
         .arg(&out)
         .arg("--quiet")
+        // Buckling of every 4th state keeps the debug-build test quick; all states are the default.
+        .args(["--states", "every:4"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -33,6 +35,9 @@ fn design_writes_every_output_and_init_round_trips() {
         "path.csv",
         "cap.obj",
         "cap.glb",
+        "trajectory.csv",
+        "program.script",
+        "report.html",
     ] {
         assert!(out.join(f).metadata().unwrap().len() > 0, "{f} missing");
     }
@@ -40,7 +45,7 @@ fn design_writes_every_output_and_init_round_trips() {
         serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     let layers = summary["counts"]["layers"].as_u64().unwrap();
     assert_eq!(summary["states"].as_array().unwrap().len() as u64, layers);
-    assert_eq!(summary["design"]["cap"]["length"].as_f64(), Some(0.1));
+    assert_eq!(summary["design"]["cap"]["length"].as_f64(), Some(0.15));
     let csv = std::fs::read_to_string(out.join("path.csv")).unwrap();
     assert_eq!(csv.lines().next(), Some("layer,index,x,y,z,tx,ty,tz"));
     assert_eq!(
@@ -48,6 +53,24 @@ fn design_writes_every_output_and_init_round_trips() {
         summary["counts"]["path_points"].as_u64().unwrap()
     );
     check_trajectory_against_path(&out, &summary);
+    // The verdict and the constraint report are in the summary.
+    assert_eq!(summary["ok"], serde_json::json!(true));
+    let names: Vec<&str> = summary["constraints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    for n in ["sigma_min", "sigma_max", "blf_min", "overhang_max"] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+    assert!(
+        summary["states"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|s| s["blf"].as_f64().is_some_and(|b| b > 1.0))
+    );
     // init refuses to overwrite.
     assert!(!kappe().arg("init").arg(&toml).status().unwrap().success());
 }

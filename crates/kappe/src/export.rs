@@ -148,3 +148,39 @@ pub fn summary_json(cap: &Cap) -> Value {
         })).collect::<Vec<_>>(),
     })
 }
+
+/// Merge an analysis into `summary.json`: per state `blf`, `max_compression_stress_pa`,
+/// `max_tension_stress_pa` (element stresses of the analysis), `max_overhang_m`, `ok`, and the
+/// top-level `constraints` report and `analysis_ok` verdict.
+pub fn add_analysis(summary: &mut Value, analysis: &crate::constraints::Analysis) {
+    if let Some(states) = summary.get_mut("states").and_then(Value::as_array_mut) {
+        for (s, a) in states.iter_mut().zip(&analysis.states) {
+            if let Some(obj) = s.as_object_mut() {
+                obj.insert("blf".into(), json!(a.blf));
+                obj.insert("buckling".into(), json!(a.buckling));
+                obj.insert(
+                    "max_compression_stress_pa".into(),
+                    json!(a.max_compression_stress_pa),
+                );
+                obj.insert(
+                    "max_tension_stress_pa".into(),
+                    json!(a.max_tension_stress_pa),
+                );
+                obj.insert("max_overhang_m".into(), json!(a.max_overhang_m));
+                obj.insert("ok".into(), json!(a.ok));
+                if let Some(m) = &a.mechanism {
+                    obj.insert("mechanism".into(), json!(m));
+                }
+            }
+        }
+    }
+    if let Some(obj) = summary.as_object_mut() {
+        obj.insert("constraints".into(), json!(analysis.constraints));
+        obj.insert("analysis_ok".into(), json!(analysis.ok));
+        obj.insert(
+            "analysis_options".into(),
+            json!(analysis.options.states.to_string()),
+        );
+        obj.insert("analysis_timings_s".into(), json!(analysis.timings));
+    }
+}

@@ -25,6 +25,13 @@ pub struct DesignArgs {
     /// Skip robot motion planning (no trajectory.csv / program.script).
     #[arg(long)]
     pub no_robot: bool,
+    /// Print states that get a shell buckling analysis: "all", "every:N" or "P%" (stresses and
+    /// overhang are always checked in every state).
+    #[arg(long, default_value = "all")]
+    pub states: String,
+    /// Skip the finite-element buckling analysis (stresses and overhang only).
+    #[arg(long)]
+    pub no_buckling: bool,
     /// Exit with status 0 even when the design fails a constraint or cannot be planned.
     #[arg(long)]
     pub allow_fail: bool,
@@ -72,6 +79,36 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     };
     bar.finish_and_clear();
 
+    // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
+    let options = kappe::constraints::AnalysisOptions {
+        states: args
+            .states
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--states: {e}"))?,
+        buckling: !args.no_buckling,
+        ..Default::default()
+    };
+    let fe_bar = if args.quiet || args.json {
+        ProgressBar::hidden()
+    } else {
+        let b = ProgressBar::new(0);
+        b.set_style(
+            ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} states ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        b.set_message("analysis");
+        b
+    };
+    let analysis = {
+        let b = &fe_bar;
+        kappe::constraints::analyze(&cap, &options, &|total| {
+            b.set_length(total as u64);
+            b.inc(1);
+        })?
+    };
+    fe_bar.finish_and_clear();
+
     // Robot: plan (verified inside the planner) unless disabled.
     let robot = if cap.design.robot.enabled && !args.no_robot {
         let spinner = if args.quiet || args.json {
@@ -102,11 +139,18 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
             serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
         }
     };
-    let robot_ok = !matches!(robot, Some(Err(_)));
+    let mut extras = crate::report_input::extras_from_analysis(&analysis);
+    if let Some(plan) = &robot {
+        crate::report_input::add_robot(&mut extras, plan);
+    }
+    let ok = crate::report_input::design_ok(&cap, &extras);
+    let report = kappe_report::render_html(&crate::report_input::report_input(&cap, &extras))?;
 
     let mut summary = kappe::export::summary_json(&cap);
+    kappe::export::add_analysis(&mut summary, &analysis);
     if let Some(obj) = summary.as_object_mut() {
         obj.insert("robot".into(), robot_json);
+        obj.insert("ok".into(), serde_json::json!(ok));
     }
     let network = kappe::export::network_json(&cap)?;
     write_dir_atomic(&args.out, |dir| {
@@ -121,6 +165,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         std::fs::write(dir.join("path.csv"), cap.path.to_csv())?;
         std::fs::write(dir.join("cap.obj"), cap.mesh.to_obj(&cap.design.name))?;
         std::fs::write(dir.join("cap.glb"), cap.mesh.to_glb())?;
+        std::fs::write(dir.join("report.html"), &report)?;
         if !trajectory.is_empty() {
             std::fs::write(dir.join("trajectory.csv"), &trajectory)?;
         }
@@ -140,6 +185,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if !args.quiet {
         print_table(&cap, &args.out);
+        print!("{}", indent(&analysis.report()));
         match &robot {
             Some(Ok(plan)) => println!(
                 "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm; \
@@ -154,15 +200,31 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
             None => println!("  robot: planning skipped"),
         }
     }
-    if !robot_ok {
-        if let Some(Err(e)) = &robot {
-            eprintln!("error: the robot cannot print this design: {e}");
+    if let Some(Err(e)) = &robot {
+        eprintln!("error: the robot cannot print this design: {e}");
+    }
+    if !ok {
+        for c in analysis.failing() {
+            eprintln!(
+                "error: constraint {} fails: worst {} {} against the limit {} {}{}",
+                c.name,
+                c.worst.map_or("n/a".into(), |w| format!("{w:.4e}")),
+                c.unit,
+                c.limit,
+                c.unit,
+                c.state
+                    .map_or(String::new(), |s| format!(" (state {s}, {})", c.element))
+            );
         }
         if !args.allow_fail {
             return Ok(ExitCode::FAILURE);
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn indent(text: &str) -> String {
+    text.lines().map(|l| format!("  {l}\n")).collect()
 }
 
 /// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
@@ -263,7 +325,7 @@ fn print_table(cap: &kappe::Cap, out: &std::path::Path) {
         cap.path.time / 60.0
     );
     println!(
-        "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb}}",
+        "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb, report.html}}",
         out.display()
     );
 }
