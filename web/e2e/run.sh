@@ -26,3 +26,9 @@ trap 'rm -rf "$OUT"' EXIT
 cargo run --quiet -p kappe-report --example demo -- "$OUT/report.html"
 KAPPE_REPORT="$OUT/report.html" KAPPE_SCREENSHOT="${KAPPE_SCREENSHOT:-$OUT/report.png}" \
   node --test web/e2e/
+
+# The same checks on a report written by `kappe design` itself: a short cap (quick in a debug
+# build) with the analysis and the robot plan, so every panel of the page holds real data.
+printf '[cap]\nlength = 0.15\n' > "$OUT/short.toml"
+cargo run --quiet -p kappe-cli -- design "$OUT/short.toml" --out "$OUT/design" --quiet --states every:4
+KAPPE_REPORT="$OUT/design/report.html" KAPPE_SCREENSHOT="$OUT/design.png" node --test web/e2e/
