@@ -23,6 +23,8 @@ pub struct Design {
     pub constraints: ConstraintSpec,
     /// Robot and tool settings (used by the motion planner).
     pub robot: RobotSpec,
+    /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
+    pub analysis: crate::constraints::AnalysisOptions,
 }
 
 /// Global geometry (method.md §2).
@@ -144,6 +146,7 @@ impl Default for Design {
             print: PrintSpec::default(),
             constraints: ConstraintSpec::default(),
             robot: RobotSpec::default(),
+            analysis: crate::constraints::AnalysisOptions::default(),
         }
     }
 }
@@ -392,6 +395,7 @@ impl Design {
                 "allowed: l_o,max > 0 m",
             )?;
         }
+        self.analysis.validate()?;
         let bm = &self.robot.beams;
         check(
             "robot.beams.width",

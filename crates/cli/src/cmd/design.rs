@@ -26,9 +26,9 @@ pub struct DesignArgs {
     #[arg(long)]
     pub no_robot: bool,
     /// Print states that get a shell buckling analysis: "all", "every:N" or "P%" (stresses and
-    /// overhang are always checked in every state).
-    #[arg(long, default_value = "all")]
-    pub states: String,
+    /// overhang are always checked in every state); overrides `[analysis] states`.
+    #[arg(long)]
+    pub states: Option<String>,
     /// Skip the finite-element buckling analysis (stresses and overhang only).
     #[arg(long)]
     pub no_buckling: bool,
@@ -80,14 +80,15 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
 
     // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
-    let options = kappe::constraints::AnalysisOptions {
-        states: args
-            .states
+    let mut options = cap.design.analysis.clone();
+    if let Some(states) = &args.states {
+        options.states = states
             .parse()
-            .map_err(|e| anyhow::anyhow!("--states: {e}"))?,
-        buckling: !args.no_buckling,
-        ..Default::default()
-    };
+            .map_err(|e| anyhow::anyhow!("--states: {e}"))?;
+    }
+    if args.no_buckling {
+        options.buckling = false;
+    }
     let fe_bar = if args.quiet || args.json {
         ProgressBar::hidden()
     } else {
