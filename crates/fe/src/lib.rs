@@ -12,7 +12,8 @@
 //! * [`BucklingSolver`] caches the symbolic factorization for models with the same mesh and
 //!   supports (e.g. the ~100 print states of a vault).
 //! * [`element::ShellElement`] is the element boundary; [`element::cst_dkt::CstDkt`] the
-//!   reference element (an ANDES membrane can replace it later).
+//!   reference element (default), [`element::andes_dkt::AndesDkt`] the ANDES/OPT membrane with
+//!   drilling freedoms + DKT, chosen by [`ShellModel::element`] ([`ElementKind`]).
 //! * [`mesh_json`] reads the fixture mesh format of `../shared/fixtures/fe/`.
 //!
 //! ```
@@ -48,7 +49,7 @@ pub mod oracle;
 mod solver;
 
 pub use error::{FeError, NodeDof};
-pub use model::{Material, NodalLoad, ShellModel, Support};
+pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use solver::{
     BucklingOptions, BucklingResult, BucklingSolver, ElementResult, SolveStats, StaticResult,
     SturmCheck, buckling, linear_static,

@@ -86,6 +86,31 @@ pub struct ShellModel {
     /// (acceptance check A10), so results do not change; only the local frames of the element
     /// results (top/bottom stresses) then follow each triangle's own normal.
     pub allow_mixed_orientation: bool,
+    /// Element formulation (default [`ElementKind::CstDkt`], the reference element of the
+    /// fixtures).
+    pub element: ElementKind,
+}
+
+/// Which facet element [`crate::BucklingSolver::new`] uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ElementKind {
+    /// CST membrane + DKT plate + drilling spring α·E·t·A ([`crate::element::cst_dkt::CstDkt`]);
+    /// the element of `facet_ref_results.json` (A2).
+    #[default]
+    CstDkt,
+    /// ANDES/OPT membrane with drilling freedoms + DKT plate
+    /// ([`crate::element::andes_dkt::AndesDkt`]); `drilling_alpha` is not used.
+    AndesDkt,
+}
+
+impl ElementKind {
+    /// The element implementation.
+    pub fn implementation(self) -> Box<dyn crate::element::ShellElement> {
+        match self {
+            Self::CstDkt => Box::new(crate::element::cst_dkt::CstDkt),
+            Self::AndesDkt => Box::new(crate::element::andes_dkt::AndesDkt),
+        }
+    }
 }
 
 /// Longest edge / smallest height above which a triangle is rejected as degenerate. Grid
@@ -110,6 +135,7 @@ impl ShellModel {
             nodal_loads: Vec::new(),
             drilling_alpha: 1.0e-3,
             allow_mixed_orientation: false,
+            element: ElementKind::CstDkt,
         }
     }
 

@@ -23,7 +23,6 @@ use faer::Mat;
 use nalgebra::{DMatrix, SymmetricEigen};
 
 use crate::assembly::{DofMap, Pattern, assemble, element_dofs, geometries, load_vector};
-use crate::element::cst_dkt::CstDkt;
 use crate::element::{Resultants, ShellElement, TriangleGeometry};
 use crate::error::{FeError, NodeDof};
 use crate::factor::{Llt, LltFailure, Symbolic};
@@ -183,12 +182,12 @@ impl std::fmt::Debug for BucklingSolver {
     }
 }
 
-/// Linear static analysis with the reference element (CST + DKT + drilling).
+/// Linear static analysis with `model.element` (default CST + DKT + drilling).
 pub fn linear_static(model: &ShellModel) -> Result<StaticResult, FeError> {
     BucklingSolver::new(model)?.linear_static(model)
 }
 
-/// Linear buckling analysis with the reference element (CST + DKT + drilling).
+/// Linear buckling analysis with `model.element` (default CST + DKT + drilling).
 pub fn buckling(model: &ShellModel, options: &BucklingOptions) -> Result<BucklingResult, FeError> {
     BucklingSolver::new(model)?.buckling(model, options)
 }
@@ -201,9 +200,11 @@ struct StaticInternal<'a> {
 }
 
 impl BucklingSolver {
-    /// Validate `model` and analyse its pattern with the reference element.
+    /// Validate `model` and analyse its pattern; the element is `model.element` (default: the
+    /// reference CST+DKT element). States solved later use this element, whatever their own
+    /// `element` field says.
     pub fn new(model: &ShellModel) -> Result<Self, FeError> {
-        Self::with_element(model, Box::new(CstDkt))
+        Self::with_element(model, model.element.implementation())
     }
 
     /// As [`BucklingSolver::new`] with another element formulation.

@@ -33,10 +33,10 @@ type B3x9 = SMatrix<f64, 3, 9>;
 type H9 = SMatrix<f64, 2, 9>;
 
 /// Local DOF index of the bending DOFs (w, θx, θy) of node i, in `U_b` order.
-const BEND: [usize; 9] = [2, 3, 4, 8, 9, 10, 14, 15, 16];
+pub(crate) const BEND: [usize; 9] = [2, 3, 4, 8, 9, 10, 14, 15, 16];
 
 /// Constitutive matrix of plane stress times a factor `f`.
-fn plane_stress(nu: f64, f: f64) -> Matrix3<f64> {
+pub(crate) fn plane_stress(nu: f64, f: f64) -> Matrix3<f64> {
     let c = f / (1.0 - nu * nu);
     Matrix3::new(
         c,
@@ -257,6 +257,36 @@ const GAUSS6: [(f64, f64, f64); 6] = [
     ),
 ];
 
+/// Add the DKT bending stiffness `Σ_{mid-sides} (A/3) B_bᵀ D_b B_b` to the bending DOFs of a
+/// local 18×18 matrix (shared by every membrane variant).
+pub(crate) fn add_dkt_bending(k: &mut Mat18, g: &TriangleGeometry, t: f64, m: &Material) {
+    let dkt = Dkt::new(g);
+    let db = plane_stress(m.poisson_ratio, m.youngs_modulus * t * t * t / 12.0);
+    let mut kb = Mat9::zeros();
+    for &(xi, eta) in &MIDSIDE {
+        let b = dkt.b(xi, eta);
+        kb += b.transpose() * db * b * (g.area / 3.0);
+    }
+    for (i, &gi) in BEND.iter().enumerate() {
+        for (j, &gj) in BEND.iter().enumerate() {
+            k[(gi, gj)] += kb[(i, j)];
+        }
+    }
+}
+
+/// DKT moments `M = D_b B_b(centroid) U_b` from the 18 local displacements.
+pub(crate) fn dkt_centroid_moment(
+    g: &TriangleGeometry,
+    t: f64,
+    m: &Material,
+    ul: &[f64; 18],
+) -> [f64; 3] {
+    let ub = SMatrix::<f64, 9, 1>::from_fn(|i, _| ul[BEND[i]]);
+    let db = plane_stress(m.poisson_ratio, m.youngs_modulus * t * t * t / 12.0);
+    let mm = db * Dkt::new(g).b(1.0 / 3.0, 1.0 / 3.0) * ub;
+    [mm[0], mm[1], mm[2]]
+}
+
 impl CstDkt {
     /// Local (element-frame) elastic stiffness, 18×18, node-major (u, v, w, θx, θy, θz).
     pub fn local_stiffness(g: &TriangleGeometry, t: f64, m: &Material, alpha: f64) -> Mat18 {
@@ -276,18 +306,7 @@ impl CstDkt {
             }
         }
         // Bending.
-        let dkt = Dkt::new(g);
-        let db = plane_stress(nu, e * t * t * t / 12.0);
-        let mut kb = Mat9::zeros();
-        for &(xi, eta) in &MIDSIDE {
-            let b = dkt.b(xi, eta);
-            kb += b.transpose() * db * b * (g.area / 3.0);
-        }
-        for (i, &gi) in BEND.iter().enumerate() {
-            for (j, &gj) in BEND.iter().enumerate() {
-                k[(gi, gj)] += kb[(i, j)];
-            }
-        }
+        add_dkt_bending(&mut k, g, t, m);
         // Drilling spring.
         let kd = alpha * e * t * g.area;
         for n in 0..3 {
@@ -338,12 +357,9 @@ impl ShellElement for CstDkt {
         let ul = to_local(u, &g.frame);
         let um = SMatrix::<f64, 6, 1>::from([ul[0], ul[1], ul[6], ul[7], ul[12], ul[13]]);
         let nm = plane_stress(m.poisson_ratio, m.youngs_modulus * t) * b_membrane(g) * um;
-        let ub = SMatrix::<f64, 9, 1>::from_fn(|i, _| ul[BEND[i]]);
-        let db = plane_stress(m.poisson_ratio, m.youngs_modulus * t * t * t / 12.0);
-        let mm = db * Dkt::new(g).b(1.0 / 3.0, 1.0 / 3.0) * ub;
         Resultants {
             membrane: [nm[0], nm[1], nm[2]],
-            moment: [mm[0], mm[1], mm[2]],
+            moment: dkt_centroid_moment(g, t, m, &ul),
         }
     }
 

@@ -1,9 +1,11 @@
-//! Shell elements behind one trait, so the membrane can be upgraded (ANDES/OPT, Felippa 2003)
-//! without touching assembly or the solvers.
+//! Shell elements behind one trait, so the membrane can be swapped without touching assembly
+//! or the solvers: [`cst_dkt::CstDkt`] (the reference element of the fixtures) and
+//! [`andes_dkt::AndesDkt`] (ANDES/OPT membrane with drilling freedoms, Felippa 2003).
 //!
 //! An element works on one flat triangle with 6 DOFs per node in the **global** frame, DOF
 //! order per node `ux, uy, uz, rx, ry, rz`, node-major (18 DOFs). It returns global matrices.
 
+pub mod andes_dkt;
 pub mod cst_dkt;
 
 use nalgebra::SMatrix;

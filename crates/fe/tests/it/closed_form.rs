@@ -3,7 +3,9 @@
 
 use std::f64::consts::PI;
 
-use kappe_fe::{BucklingOptions, NodalLoad, ShellModel, Support, buckling, linear_static};
+use kappe_fe::{
+    BucklingOptions, ElementKind, NodalLoad, ShellModel, Support, buckling, linear_static,
+};
 
 use crate::common::{load_mesh, material, rel};
 
@@ -162,16 +164,37 @@ fn a5_cylinder_axial() {
 /// within 2 %. **Deviation from the spec**: the spec asks for 2 % at 16×16, but the CST
 /// membrane is too stiff for that (16×16 gives −4.2 %, converging from below: −1.6 % at
 /// 32×32, −0.9 % at 64×64, see `examples/scordelis_lo.rs`); the check is made at 32×32 and
-/// the 16×16 value must lie below it (monotone convergence). ANDES would close this gap.
+/// the 16×16 value must lie below it (monotone convergence). The ANDES element meets the
+/// spec at 16×16 (`a7_scordelis_lo_andes`).
 #[test]
 fn a7_scordelis_lo() {
-    let w16 = scordelis_lo(16);
-    let w32 = scordelis_lo(32);
+    let w16 = scordelis_lo(16, ElementKind::CstDkt);
+    let w32 = scordelis_lo(32, ElementKind::CstDkt);
     assert!(w16 < w32 && w32 < 0.3024, "{w16} {w32}");
     assert!(rel(w32, 0.3024) < 0.02, "{w32} vs 0.3024");
 }
 
-fn scordelis_lo(n: usize) -> f64 {
+/// A7 with ANDES/OPT+DKT, as the spec asks: 16×16 within 2 % of 0.3024, and converging: 32×32
+/// also within 2 %, and its change from 16×16 less than half the change from 8×8 to 16×16
+/// (O(h²) convergence would give a quarter; measured 0.30328 → 0.30116 → 0.30069, i.e. 0.22).
+/// Both elements approach ≈ 0.3005 on fine meshes (CST+DKT 0.29976, ANDES 0.30057 at 64×64,
+/// `examples/scordelis_lo.rs`): 0.6 % under 0.3024, the Kirchhoff (no transverse shear)
+/// value of this roof, well inside the 2 %.
+#[test]
+fn a7_scordelis_lo_andes() {
+    let w8 = scordelis_lo(8, ElementKind::AndesDkt);
+    let w16 = scordelis_lo(16, ElementKind::AndesDkt);
+    let w32 = scordelis_lo(32, ElementKind::AndesDkt);
+    println!("ANDES Scordelis–Lo: 8×8 {w8}, 16×16 {w16}, 32×32 {w32}");
+    assert!(rel(w16, 0.3024) < 0.02, "16×16: {w16} vs 0.3024");
+    assert!(rel(w32, 0.3024) < 0.02, "32×32: {w32} vs 0.3024");
+    assert!(
+        (w32 - w16).abs() < 0.5 * (w16 - w8).abs(),
+        "not converging: {w8} {w16} {w32}"
+    );
+}
+
+fn scordelis_lo(n: usize, element: ElementKind) -> f64 {
     let (r0, half_l, ang) = (25.0, 25.0, 40.0_f64.to_radians());
     let mut nodes = Vec::new();
     for j in 0..=n {
@@ -184,6 +207,7 @@ fn scordelis_lo(n: usize) -> f64 {
     let tris = kappe_fe::generate::alternating_triangles(n, n);
     let t = 0.25;
     let mut m = ShellModel::new(nodes, tris, t, material(4.32e8, 0.0, 90.0 / t));
+    m.element = element;
     let id = |i: usize, j: usize| j * (n + 1) + i;
     let mut fixed = vec![[false; 6]; (n + 1) * (n + 1)];
     for j in 0..=n {

@@ -1,7 +1,9 @@
 //! A1: element patch tests — constant membrane strain and constant curvature reproduced
 //! exactly on an irregular 5-triangle patch (in a tilted plane, so the local frames are
-//! exercised); the 6 rigid-body modes of a curved patch carry zero energy.
+//! exercised); the 6 rigid-body modes of a curved patch carry zero energy. Run for both
+//! elements: the reference CST+DKT and ANDES/OPT+DKT.
 
+use kappe_fe::element::andes_dkt::AndesDkt;
 use kappe_fe::element::cst_dkt::CstDkt;
 use kappe_fe::element::{ShellElement, TriangleGeometry};
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -28,6 +30,7 @@ fn tilt() -> Matrix3<f64> {
 
 /// Internal nodal forces Σ K_e u_e of the patch (global 6 per node).
 fn internal_forces(
+    el: &dyn ShellElement,
     x: &[[f64; 3]],
     tris: &[[usize; 3]],
     u: &[[f64; 6]],
@@ -37,7 +40,7 @@ fn internal_forces(
     let mut f = vec![[0.0; 6]; x.len()];
     for t in tris {
         let g = TriangleGeometry::new(&[x[t[0]], x[t[1]], x[t[2]]]);
-        let k = CstDkt.stiffness(&g, 0.05, &mat, alpha);
+        let k = el.stiffness(&g, 0.05, &mat, alpha);
         let ue = nalgebra::SVector::<f64, 18>::from_fn(|i, _| u[t[i / 6]][i % 6]);
         let fe = k * ue;
         for (a, &n) in t.iter().enumerate() {
@@ -60,6 +63,20 @@ fn to_global(r: &Matrix3<f64>, local: [f64; 3]) -> [f64; 3] {
 /// exactly by CST and DKT, so only round-off remains.
 #[test]
 fn a1_constant_strain_and_curvature() {
+    // CST: drilling DOFs at 0 (the spring acts on the absolute θz and is not part of the
+    // linear field).
+    constant_strain_and_curvature(&CstDkt, false);
+}
+
+/// A1 for ANDES/OPT+DKT: the same patch test, with the drilling DOFs set to the field's
+/// true rotation ω = (v,x − u,y)/2 — the state the ANDES membrane represents exactly (its
+/// basic stiffness passes the patch test, the higher-order strain vanishes for θ_i = ω).
+#[test]
+fn a1_andes_constant_strain_and_curvature() {
+    constant_strain_and_curvature(&AndesDkt, true);
+}
+
+fn constant_strain_and_curvature(el: &dyn ShellElement, drill_rotation: bool) {
     let (p2, tris) = patch_2d();
     let r = tilt(); // local = r · global
     let x: Vec<[f64; 3]> = p2
@@ -71,6 +88,11 @@ fn a1_constant_strain_and_curvature() {
     // Membrane: u = 1e-3(2x + 0.5y), v = 1e-3(−0.7x + 1.5y) → ε = 1e-3(2, 1.5, −0.2).
     // Bending: w = 1e-3(0.8x² − 0.6xy + 0.3y²); θx = w,y, θy = −w,x, drilling 0.
     let (a, b, c) = (0.8e-3, -0.6e-3, 0.3e-3);
+    let omega = if drill_rotation {
+        0.5e-3 * (-0.7 - 0.5)
+    } else {
+        0.0
+    };
     let u: Vec<[f64; 6]> = p2
         .iter()
         .map(|&[px, py]| {
@@ -79,13 +101,13 @@ fn a1_constant_strain_and_curvature() {
                 1e-3 * (-0.7 * px + 1.5 * py),
                 a * px * px + b * px * py + c * py * py,
             ];
-            let th = [b * px + 2.0 * c * py, -(2.0 * a * px + b * py), 0.0];
+            let th = [b * px + 2.0 * c * py, -(2.0 * a * px + b * py), omega];
             let ug = to_global(&r, ul);
             let tg = to_global(&r, th);
             [ug[0], ug[1], ug[2], tg[0], tg[1], tg[2]]
         })
         .collect();
-    let f = internal_forces(&x, &tris, &u, 1e-3);
+    let f = internal_forces(el, &x, &tris, &u, 1e-3);
     let scale = f
         .iter()
         .flat_map(|v| v.iter())
@@ -115,7 +137,7 @@ fn a1_constant_strain_and_curvature() {
     for tri in &tris {
         let g = TriangleGeometry::new(&[x[tri[0]], x[tri[1]], x[tri[2]]]);
         let ue: [f64; 18] = std::array::from_fn(|i| u[tri[i / 6]][i % 6]);
-        let res = CstDkt.resultants(&g, t, &mat, &ue);
+        let res = el.resultants(&g, t, &mat, &ue);
         // Resultants are in the element frame; rotate the plane tensors from the patch frame.
         let e1 = Vector3::from(g.frame[0]);
         let e1p = r * e1; // element x axis in patch-local coordinates
@@ -160,6 +182,18 @@ fn a1_constant_strain_and_curvature() {
 /// α = 0, and with α = 1e-3 the spurious force must stay at the α·E·t·A level.
 #[test]
 fn a1_rigid_body_modes_curved_patch() {
+    rigid_body_modes(&CstDkt, true);
+}
+
+/// A1 for ANDES/OPT+DKT: rigid-body modes of the curved patch give zero internal forces at
+/// 1e-10 of ‖K‖·‖u‖ with the model's default `drilling_alpha` = 1e-3 passed in — the ANDES
+/// drilling DOF is the true rotation, so there is no spring to switch off.
+#[test]
+fn a1_andes_rigid_body_modes_curved_patch() {
+    rigid_body_modes(&AndesDkt, false);
+}
+
+fn rigid_body_modes(el: &dyn ShellElement, absolute_spring: bool) {
     let (p2, tris) = patch_2d();
     let x: Vec<[f64; 3]> = p2
         .iter()
@@ -193,7 +227,8 @@ fn a1_rigid_body_modes_curved_patch() {
                 v
             })
             .collect();
-        let f = internal_forces(&x, &tris, &u, 0.0);
+        let alpha = if absolute_spring { 0.0 } else { 1e-3 };
+        let f = internal_forces(el, &x, &tris, &u, alpha);
         let _ = mat;
         for (n, fn_) in f.iter().enumerate() {
             for d in 0..6 {
@@ -204,8 +239,11 @@ fn a1_rigid_body_modes_curved_patch() {
                 );
             }
         }
+        if !absolute_spring {
+            continue;
+        }
         // Patch area ≈ 1.5 m² → α E t A ≈ 1.5e-3·kscale per unit rotation, spread over nodes.
-        let f = internal_forces(&x, &tris, &u, 1e-3);
+        let f = internal_forces(el, &x, &tris, &u, 1e-3);
         for fn_ in &f {
             for v in fn_ {
                 assert!(v.abs() < 2e-3 * kscale, "alpha-level bound: {v}");
@@ -215,7 +253,8 @@ fn a1_rigid_body_modes_curved_patch() {
 }
 
 /// Orientation independence (part of A10): reversing a triangle's node order gives the same
-/// global stiffness and geometric stiffness (after permuting the node blocks back).
+/// global stiffness and geometric stiffness (after permuting the node blocks back), for both
+/// elements.
 #[test]
 fn a10_element_orientation_independent() {
     let x = [[0.1, 0.0, 0.2], [1.0, 0.3, 0.1], [0.4, 0.9, -0.3]];
@@ -253,6 +292,16 @@ fn a10_element_orientation_independent() {
             CstDkt.geometric_stiffness(&g1, &nf),
             CstDkt.geometric_stiffness(&g2, &nf2),
             "K_G",
+        ),
+        (
+            AndesDkt.stiffness(&g1, 0.02, &mat, 1e-3),
+            AndesDkt.stiffness(&g2, 0.02, &mat, 1e-3),
+            "ANDES K",
+        ),
+        (
+            AndesDkt.geometric_stiffness(&g1, &nf),
+            AndesDkt.geometric_stiffness(&g2, &nf2),
+            "ANDES K_G",
         ),
     ] {
         let scale = k1.abs().max();

@@ -4,6 +4,7 @@
 // Index loops mirror the formulas (DOF d of node n).
 #![allow(clippy::needless_range_loop)]
 
+mod andes;
 mod bad_input;
 mod closed_form;
 mod common;
