@@ -9,7 +9,8 @@
 //!   "load": {"type": "self_weight", "direction": [0, 0, -1]}
 //!        |  {"type": "nodal_forces", "forces": [[node, [fx, fy, fz]], [node, [fx, fy, fz, mx, my, mz]]]}
 //!        |  [ ...several of these... ],
-//!   "drilling_alpha": 1e-3,                // optional
+//!   "drilling_alpha": 1e-3,                // optional (CST+DKT only)
+//!   "element": "cst_dkt",                  // optional: "cst_dkt" (default) | "andes_dkt"
 //!   "allow_mixed_orientation": false }     // optional
 //! ```
 //! Self-weight γ·t per unit area acts whenever γ > 0, along `direction` of a `self_weight`
@@ -19,7 +20,7 @@
 use serde_json::Value;
 
 use crate::error::FeError;
-use crate::model::{Material, NodalLoad, ShellModel, Support};
+use crate::model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 
 fn fmt_err(field: impl Into<String>, detail: impl Into<String>) -> FeError {
     FeError::MeshFormat {
@@ -258,6 +259,14 @@ pub fn parse_mesh(text: &str) -> Result<ShellModel, FeError> {
     model.nodal_loads = nodal_loads;
     if let Some(a) = obj.get("drilling_alpha") {
         model.drilling_alpha = num(a, "drilling_alpha")?;
+    }
+    if let Some(a) = obj.get("element") {
+        model.element = a.as_str().and_then(ElementKind::from_name).ok_or_else(|| {
+            fmt_err(
+                "element",
+                format!("unknown element {a}; allowed: \"cst_dkt\", \"andes_dkt\""),
+            )
+        })?;
     }
     if let Some(a) = obj.get("allow_mixed_orientation") {
         model.allow_mixed_orientation = a

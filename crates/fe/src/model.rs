@@ -104,6 +104,32 @@ pub enum ElementKind {
 }
 
 impl ElementKind {
+    /// Parse the names used in mesh JSON and on the command line: `cst_dkt` / `cst`,
+    /// `andes_dkt` / `andes`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "cst_dkt" | "cst" => Some(Self::CstDkt),
+            "andes_dkt" | "andes" => Some(Self::AndesDkt),
+            _ => None,
+        }
+    }
+
+    /// The mesh-JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::CstDkt => "cst_dkt",
+            Self::AndesDkt => "andes_dkt",
+        }
+    }
+
+    /// One-line description for reports.
+    pub fn description(self) -> &'static str {
+        match self {
+            Self::CstDkt => "CST + DKT + drilling (alpha = model drilling_alpha)",
+            Self::AndesDkt => "ANDES/OPT membrane with drilling freedoms + DKT (Felippa 2003)",
+        }
+    }
+
     /// The element implementation.
     pub fn implementation(self) -> Box<dyn crate::element::ShellElement> {
         match self {

@@ -26,7 +26,7 @@ use crate::assembly::{DofMap, Pattern, assemble, element_dofs, geometries, load_
 use crate::element::{Resultants, ShellElement, TriangleGeometry};
 use crate::error::{FeError, NodeDof};
 use crate::factor::{Llt, LltFailure, Symbolic};
-use crate::model::ShellModel;
+use crate::model::{ElementKind, ShellModel};
 
 /// Results of a linear static analysis.
 #[derive(Debug, Clone, PartialEq)]
@@ -170,6 +170,9 @@ pub struct BucklingSolver {
     pattern: Pattern,
     symbolic: Symbolic,
     element: Box<dyn ShellElement>,
+    /// `Some` when the element came from `model.element` ([`BucklingSolver::new`]): later
+    /// states must name the same element.
+    kind: Option<ElementKind>,
     t_symbolic: f64,
 }
 
@@ -201,13 +204,16 @@ struct StaticInternal<'a> {
 
 impl BucklingSolver {
     /// Validate `model` and analyse its pattern; the element is `model.element` (default: the
-    /// reference CST+DKT element). States solved later use this element, whatever their own
-    /// `element` field says.
+    /// reference CST+DKT element). States solved later must have the same `element`
+    /// (`PatternMismatch` otherwise).
     pub fn new(model: &ShellModel) -> Result<Self, FeError> {
-        Self::with_element(model, model.element.implementation())
+        let mut s = Self::with_element(model, model.element.implementation())?;
+        s.kind = Some(model.element);
+        Ok(s)
     }
 
-    /// As [`BucklingSolver::new`] with another element formulation.
+    /// As [`BucklingSolver::new`] with another element formulation (`model.element` is then
+    /// not used).
     pub fn with_element(
         model: &ShellModel,
         element: Box<dyn ShellElement>,
@@ -227,6 +233,7 @@ impl BucklingSolver {
             pattern,
             symbolic,
             element,
+            kind: None,
             t_symbolic: t0.elapsed().as_secs_f64(),
         })
     }
@@ -246,6 +253,11 @@ impl BucklingSolver {
         if model.fixed_mask() != self.fixed {
             return Err(FeError::PatternMismatch {
                 reason: "different supports",
+            });
+        }
+        if self.kind.is_some_and(|k| k != model.element) {
+            return Err(FeError::PatternMismatch {
+                reason: "different element",
             });
         }
         Ok(())

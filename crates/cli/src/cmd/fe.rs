@@ -6,9 +6,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use clap::{Args, Subcommand};
+use clap::{Args, Subcommand, ValueEnum};
 use kappe_fe::mesh_json::parse_mesh;
-use kappe_fe::{BucklingOptions, BucklingSolver, ShellModel, StaticResult};
+use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, ShellModel, StaticResult};
 use serde_json::{Value, json};
 
 use crate::output::write_file_atomic;
@@ -40,6 +40,27 @@ pub struct BuckleArgs {
     /// Accept triangles oriented against their neighbours (results are orientation-independent).
     #[arg(long)]
     allow_mixed_orientation: bool,
+    /// Element formulation; overrides the mesh's "element" (default there: cst).
+    #[arg(long, value_enum)]
+    element: Option<ElementArg>,
+}
+
+/// `--element`: the facet element of `kappe_fe::ElementKind`.
+#[derive(Clone, Copy, ValueEnum)]
+enum ElementArg {
+    /// CST membrane + DKT plate + drilling spring (the reference element of the fixtures).
+    Cst,
+    /// ANDES/OPT membrane with drilling freedoms + DKT plate (better membrane on coarse meshes).
+    Andes,
+}
+
+impl From<ElementArg> for ElementKind {
+    fn from(e: ElementArg) -> Self {
+        match e {
+            ElementArg::Cst => ElementKind::CstDkt,
+            ElementArg::Andes => ElementKind::AndesDkt,
+        }
+    }
 }
 
 #[derive(Args)]
@@ -53,6 +74,9 @@ pub struct StaticArgs {
     /// element frames then follow each triangle's own normal).
     #[arg(long)]
     allow_mixed_orientation: bool,
+    /// Element formulation; overrides the mesh's "element" (default there: cst).
+    #[arg(long, value_enum)]
+    element: Option<ElementArg>,
 }
 
 pub fn run(cmd: FeCommand) -> Result<ExitCode> {
@@ -62,12 +86,19 @@ pub fn run(cmd: FeCommand) -> Result<ExitCode> {
     }
 }
 
-fn load(path: &Path, allow_mixed_orientation: bool) -> Result<ShellModel> {
+fn load(
+    path: &Path,
+    allow_mixed_orientation: bool,
+    element: Option<ElementArg>,
+) -> Result<ShellModel> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut model =
         parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))?;
     model.allow_mixed_orientation |= allow_mixed_orientation;
+    if let Some(e) = element {
+        model.element = e.into();
+    }
     Ok(model)
 }
 
@@ -104,7 +135,7 @@ fn static_summary(s: &StaticResult) -> Value {
 
 fn buckle(args: BuckleArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let model = load(&args.mesh, args.allow_mixed_orientation)?;
+    let model = load(&args.mesh, args.allow_mixed_orientation, args.element)?;
     let source = args.mesh.display().to_string();
     let options = BucklingOptions {
         modes: args.modes,
@@ -130,7 +161,8 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
             "factors_below_sigma": c.found_below,
         })),
         "solver": {
-            "element": "CST + DKT + drilling (alpha = model drilling_alpha)",
+            "element": model.element.description(),
+            "element_kind": model.element.name(),
             "nnz_k": s.nnz_k,
             "nnz_l": s.nnz_l,
             "operator_applications": s.operator_applications,
@@ -151,7 +183,7 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
 
 fn statics(args: StaticArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
-    let model = load(&args.mesh, args.allow_mixed_orientation)?;
+    let model = load(&args.mesh, args.allow_mixed_orientation, args.element)?;
     let source = args.mesh.display().to_string();
     let r = kappe_fe::linear_static(&model)
         .with_context(|| format!("static analysis of {source} failed"))?;
@@ -179,6 +211,7 @@ fn statics(args: StaticArgs) -> Result<ExitCode> {
     let doc = json!({
         "static": static_summary(&r),
         "dofs": r.n_free_dofs,
+        "element": model.element.name(),
         "mesh_quality": quality(&model),
         "time_s": t0.elapsed().as_secs_f64(),
         "displacements": r.displacements,

@@ -145,3 +145,40 @@ fn andes_solver_sturm_residual_dense() {
         r.factors[0]
     );
 }
+
+/// The element is part of what a `BucklingSolver` caches: a state naming another element is
+/// rejected (`PatternMismatch`), not silently solved with the solver's element.
+#[test]
+fn solver_rejects_state_with_other_element() {
+    let mut m = kappe_fe::generate::barrel_vault(6, 4);
+    m.element = ElementKind::AndesDkt;
+    let solver = BucklingSolver::new(&m).unwrap();
+    assert!(solver.linear_static(&m).is_ok());
+    let mut other = m.clone();
+    other.element = ElementKind::CstDkt;
+    assert!(matches!(
+        solver.linear_static(&other),
+        Err(kappe_fe::FeError::PatternMismatch {
+            reason: "different element"
+        })
+    ));
+}
+
+/// Mesh JSON `"element"`: names parsed, unknown names rejected with the field named.
+#[test]
+fn mesh_json_element_field() {
+    let base = r#"{"nodes": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]], "thickness": 0.01,
+        "E": 1e6, "nu": 0.3, "gamma": 0, "supports": {"ux": [0]}"#;
+    let parse = |extra: &str| kappe_fe::mesh_json::parse_mesh(&format!("{base}{extra}}}"));
+    assert_eq!(parse("").unwrap().element, ElementKind::CstDkt);
+    assert_eq!(
+        parse(r#", "element": "andes_dkt""#).unwrap().element,
+        ElementKind::AndesDkt
+    );
+    assert_eq!(
+        parse(r#", "element": "cst_dkt""#).unwrap().element,
+        ElementKind::CstDkt
+    );
+    let err = parse(r#", "element": "mitc3""#).unwrap_err().to_string();
+    assert!(err.contains("element") && err.contains("mitc3"), "{err}");
+}
