@@ -80,17 +80,7 @@ impl PrototypeFile {
     /// Parse TOML; unknown fields and a `failed` prototype without `failed_at_layer` (or a
     /// `stood` one with it) are errors naming the entry.
     pub fn from_toml_str(text: &str) -> Result<PrototypeFile, DesignError> {
-        let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
-            path: String::new(),
-            message: e.to_string().trim().to_string(),
-        })?;
-        let file: PrototypeFile = serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            DesignError::Parse {
-                path,
-                message: e.into_inner().message().trim().to_string(),
-            }
-        })?;
+        let file: PrototypeFile = crate::spec::parse_toml(text)?;
         file.analysis.validate()?;
         if file.prototypes.is_empty() {
             return Err(DesignError::Invalid {

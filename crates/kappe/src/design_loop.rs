@@ -94,17 +94,7 @@ pub struct FreeParameter {
 impl OptimizeFile {
     /// Parse TOML (unknown fields are errors naming the entry).
     pub fn from_toml_str(text: &str) -> Result<OptimizeFile, DesignError> {
-        let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
-            path: String::new(),
-            message: e.to_string().trim().to_string(),
-        })?;
-        let file: OptimizeFile = serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            DesignError::Parse {
-                path,
-                message: e.into_inner().message().trim().to_string(),
-            }
-        })?;
+        let file: OptimizeFile = crate::spec::parse_toml(text)?;
         file.analysis.validate()?;
         file.verify.validate()?;
         file.parameters()?;

@@ -208,20 +208,7 @@ impl Design {
     /// assert_eq!(d.cap.rise, 0.2);
     /// ```
     pub fn from_toml_str(text: &str) -> Result<Design, DesignError> {
-        let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
-            path: String::new(),
-            message: e.to_string().trim().to_string(),
-        })?;
-        let design: Design = serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            let inner = e.into_inner();
-            let message = inner.message().trim().to_string();
-            let message = match did_you_mean(&message) {
-                Some(hint) => format!("{message} (did you mean `{hint}`?)"),
-                None => message,
-            };
-            DesignError::Parse { path, message }
-        })?;
+        let design: Design = parse_toml(text)?;
         design.validate()?;
         Ok(design)
     }
@@ -417,6 +404,24 @@ impl Design {
         )?;
         Ok(())
     }
+}
+
+/// Deserialize TOML text into `T`, reporting the dotted path of a bad entry and, for an unknown
+/// field, the closest allowed name. Every TOML file Kappe reads goes through here.
+pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, DesignError> {
+    let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
+        path: String::new(),
+        message: e.to_string().trim().to_string(),
+    })?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.into_inner().message().trim().to_string();
+        let message = match did_you_mean(&message) {
+            Some(hint) => format!("{message} (did you mean `{hint}`?)"),
+            None => message,
+        };
+        DesignError::Parse { path, message }
+    })
 }
 
 /// For serde's "unknown field `x`, expected one of `a`, `b`, …", the expected name closest to `x`

@@ -57,26 +57,9 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
                 .with_context(|| format!("invalid design file {}", path.display()))?
         }
     };
-    let bar = if args.quiet || args.json {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new(0);
-        b.set_style(
-            ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} states ({elapsed})")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        b.set_message("print states");
-        b
-    };
-    // The number of states is known only after form-finding; the bar learns it on the first tick.
-    let cap = {
-        let bar_ref = &bar;
-        kappe::design_cap(&design, &|total| {
-            bar_ref.set_length(total as u64);
-            bar_ref.inc(1);
-        })?
-    };
+    let silent = args.quiet || args.json;
+    let bar = state_bar("print states", silent);
+    let cap = kappe::design_cap(&design, &|total| tick(&bar, total))?;
     bar.finish_and_clear();
 
     // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
@@ -89,30 +72,13 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     if args.no_buckling {
         options.buckling = false;
     }
-    let fe_bar = if args.quiet || args.json {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new(0);
-        b.set_style(
-            ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} states ({elapsed})")
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        b.set_message("analysis");
-        b
-    };
-    let analysis = {
-        let b = &fe_bar;
-        kappe::constraints::analyze(&cap, &options, &|total| {
-            b.set_length(total as u64);
-            b.inc(1);
-        })?
-    };
+    let fe_bar = state_bar("analysis", silent);
+    let analysis = kappe::constraints::analyze(&cap, &options, &|total| tick(&fe_bar, total))?;
     fe_bar.finish_and_clear();
 
     // Robot: plan (verified inside the planner) unless disabled.
     let robot = if cap.design.robot.enabled && !args.no_robot {
-        let spinner = if args.quiet || args.json {
+        let spinner = if silent {
             ProgressBar::hidden()
         } else {
             ProgressBar::new_spinner()
@@ -222,6 +188,27 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// A bar over print states (hidden when quiet); its length is learnt on the first tick, since
+/// the number of states is known only after form-finding.
+fn state_bar(message: &'static str, hidden: bool) -> ProgressBar {
+    if hidden {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(0);
+    b.set_style(
+        ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} states ({elapsed})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    b.set_message(message);
+    b
+}
+
+fn tick(bar: &ProgressBar, total: usize) {
+    bar.set_length(total as u64);
+    bar.inc(1);
 }
 
 fn indent(text: &str) -> String {
