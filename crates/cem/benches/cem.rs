@@ -1,5 +1,5 @@
 //! Speed of the CEM solver against the compas_cem anchors of cem.md §9
-//! (`cargo bench -p kappe-cem`). Targets (100× compas_cem 0.8.6): vault_grid500 ≤ 0.2 ms,
+//! (`cargo bench -p cem`). Targets (100× compas_cem 0.8.6): vault_grid500 ≤ 0.2 ms,
 //! vault_grid500_braced ≤ 1.5 ms, vault_grid5000 ≤ 4.7 ms.
 
 use kappe_cem::example::vault_grid;
