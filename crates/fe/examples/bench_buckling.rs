@@ -2,7 +2,7 @@
 //! meshes of the fixture family (`generate::barrel_vault`), ~10⁴ and ~10⁵ nodes. Prints a
 //! markdown table (wall times per phase, nnz, operator applications, peak RSS).
 //!
-//! `cargo run --release -p kappe-fe --example bench_buckling [-- all|small|large|small-sturm|large-nosturm|…]`
+//! `cargo run --release -p fe --example bench_buckling [-- all|small|large|small-sturm|large-nosturm|…]`
 //! Targets (buckling.md §4): 10⁴ nodes ≤ 2 s, 10⁵ nodes ≤ 30 s and ≤ 2 GB, on 2 cores.
 
 use std::time::Instant;

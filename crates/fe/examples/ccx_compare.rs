@@ -3,7 +3,7 @@
 //! `ccx` (must be on PATH, e.g. `apt-get install calculix-ccx`), and prints a table with the
 //! ccx wall time and factors next to kappe-fe's.
 //!
-//! `cargo run --release -p kappe-fe --example ccx_compare -- [N_ARC N_LEN [WORKDIR]]`
+//! `cargo run --release -p fe --example ccx_compare -- [N_ARC N_LEN [WORKDIR]]`
 //! (default 130 76 → 10 087 nodes, workdir `target/ccx_compare`). OMP_NUM_THREADS=2.
 //!
 //! ccx expands S3/S4 shells to one layer of C3D6/C3D8I solids (3 nodes through the thickness

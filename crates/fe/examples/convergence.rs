@@ -5,7 +5,7 @@
 //! Prints a table per element (reference CST+DKT, then ANDES/OPT+DKT) and exits non-zero if
 //! a check fails.
 //!
-//! `cargo run --release -p kappe-fe --example convergence [-- cst|andes]`
+//! `cargo run --release -p fe --example convergence [-- cst|andes]`
 
 use std::process::ExitCode;
 

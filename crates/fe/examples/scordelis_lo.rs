@@ -3,7 +3,7 @@
 //!
 //! with the reference CST+DKT element (α = 1e-3) and the ANDES/OPT+DKT element.
 //!
-//! `cargo run --release -p kappe-fe --example scordelis_lo`
+//! `cargo run --release -p fe --example scordelis_lo`
 
 use kappe_fe::{ElementKind, Material, ShellModel, Support, linear_static};
 
