@@ -2,13 +2,14 @@
 //! meshes of the fixture family (`generate::barrel_vault`), ~10⁴ and ~10⁵ nodes. Prints a
 //! markdown table (wall times per phase, nnz, operator applications, peak RSS).
 //!
-//! `cargo run --release -p fe --example bench_buckling [-- all|small|large|small-sturm|large-nosturm|…]`
+//! `cargo run --release -p fe --example bench_buckling [-- all|small|large|small-sturm|large-nosturm|… [cst|andes]]`
+//! (second argument: the element, default the reference CST+DKT).
 //! Targets (buckling.md §4): 10⁴ nodes ≤ 2 s, 10⁵ nodes ≤ 30 s and ≤ 2 GB, on 2 cores.
 
 use std::time::Instant;
 
 use kappe_fe::generate::barrel_vault;
-use kappe_fe::{BucklingOptions, BucklingSolver, FeError};
+use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, FeError};
 
 /// Peak resident set size of this process (MB) from /proc (Linux); `None` elsewhere.
 fn peak_rss_mb() -> Option<f64> {
@@ -18,8 +19,9 @@ fn peak_rss_mb() -> Option<f64> {
     Some(kb / 1024.0)
 }
 
-fn run(n_arc: usize, n_len: usize, sturm: bool) -> Result<(), FeError> {
-    let model = barrel_vault(n_arc, n_len);
+fn run(n_arc: usize, n_len: usize, sturm: bool, element: ElementKind) -> Result<(), FeError> {
+    let mut model = barrel_vault(n_arc, n_len);
+    model.element = element;
     let t0 = Instant::now();
     let solver = BucklingSolver::new(&model)?;
     let r = solver.buckling(
@@ -57,6 +59,11 @@ fn run(n_arc: usize, n_len: usize, sturm: bool) -> Result<(), FeError> {
 
 fn main() -> Result<(), FeError> {
     let which = std::env::args().nth(1).unwrap_or_else(|| "all".into());
+    let element = std::env::args()
+        .nth(2)
+        .and_then(|e| ElementKind::from_name(&e))
+        .unwrap_or_default();
+    println!("element: {}\n", element.description());
     println!(
         "| nodes | free DOFs | Sturm | nnz(K) | nnz(L) | symbolic s | assembly s | factor+static s | stresses+K_G s | Lanczos s | Sturm s | K⁻¹K_G applications | total s | peak RSS MB | λ₁, λ₂, λ₃ |"
     );
@@ -71,7 +78,7 @@ fn main() -> Result<(), FeError> {
         for sturm in [false, true] {
             let tag = format!("{name}-{}", if sturm { "sturm" } else { "nosturm" });
             if which == "all" || which == name || which == tag {
-                run(na, nl, sturm)?;
+                run(na, nl, sturm, element)?;
             }
         }
     }
