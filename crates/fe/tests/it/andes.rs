@@ -196,9 +196,10 @@ fn mesh_json_element_field() {
 /// moments from the exact field u = ε(x − ½), v = −νε(y − ½), θ = 0, which the supports
 /// admit) the solver returns the exact field and every element carries the uniaxial tension
 /// N_x = 1 N/m (measured deviation 4e-15 N/m; asserted 1e-9). The dense pencil then has no
-/// positive factor; the sparse Lanczos path is not part of this test because on this
-/// no-compression case it ends in `NoConvergence` (spurious positive Ritz values after ~170
-/// steps, see README "Left to do").
+/// positive factor; the sparse Lanczos path is not part of this test because on this tiny
+/// no-compression case it ends in `NoConvergence` (spurious positive Ritz values once the
+/// basis approaches the full dimension, see README "Left to do"; the 12×12 plate returns
+/// the empty list).
 #[test]
 fn andes_tension_with_consistent_loads_is_exact() {
     let n = 6;
