@@ -20,8 +20,8 @@
 //!
 //! [`design_ok`] is the one place where a design's verdict is decided: `kappe design` (exit
 //! status) and `kappe study` (the pass/fail column) both call it, so they cannot disagree.
-//! [`analyse`] is the one place where the analysis joins the pipeline; today it returns no
-//! analysis and the verdict is the preliminary one.
+//! [`evaluate`] is the one place where the analysis and the robot plan join the pipeline after
+//! form-finding, for both commands.
 
 use kappe::Cap;
 use kappe_report::{
@@ -41,12 +41,8 @@ const STRESS_RELATIVE_TOLERANCE: f64 = 1e-9;
 /// so this bounds the island at ~20 MB (the default design needs ~0.3 million).
 const MAX_STATE_STRESS_VALUES: usize = 2_000_000;
 
-/// Results of one print state from the analysis (`kappe::constraints::analyze` when it exists).
+/// Results of one print state from the analysis (`kappe::constraints::analyze`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[allow(
-    dead_code,
-    reason = "constructed by the analysis wiring of issue 8 (lead)"
-)]
 pub struct StateCheck {
     /// Lowest positive linear buckling load factor of the state, if computed.
     pub blf: Option<f64>,
@@ -76,35 +72,108 @@ pub struct ReportExtras {
     pub plots: Vec<Plot>,
 }
 
-/// The one place where the analysis joins the pipeline, for both `kappe design` and
-/// `kappe study`: with `options`, the finite-element analysis of `kappe::constraints::analyze`
-/// (per-state BLF and verdict, the constraint table, the overall verdict); without, nothing is
-/// added and [`design_ok`] decides on the preliminary checks (stresses and overhang).
+/// What follows form-finding for one design: the analysis of every state (when asked for), the
+/// robot plan (when asked for) and the verdict. `kappe design` and `kappe study` both run a design through this, so
+/// their verdicts cannot disagree.
+#[derive(Debug)]
+pub struct Evaluation {
+    /// Stresses, overhang and buckling of every state, and the constraint report; `None` when
+    /// not asked for (the verdict is then the preliminary one of [`design_ok`]).
+    pub analysis: Option<kappe::constraints::Analysis>,
+    /// The robot plan, or why there is none; `None` when planning was not asked for.
+    pub robot: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The analysis and robot results in report form.
+    pub extras: ReportExtras,
+    /// The verdict of [`design_ok`].
+    pub ok: bool,
+}
+
+/// Analyse `cap` with `options` (none: no analysis), plan the robot if `plan_robot`, and decide
+/// the verdict.
+/// `on_fe(total)` ticks once per buckling solve; `before_plan` runs just before planning starts
+/// (for a spinner).
 ///
 /// # Errors
 /// What `analyze` returns (invalid options, a state that cannot be rebuilt).
-pub fn analyse(
+pub fn evaluate(
     cap: &Cap,
     options: Option<&kappe::constraints::AnalysisOptions>,
-) -> Result<ReportExtras, kappe::DesignError> {
-    match options {
-        None => Ok(ReportExtras::default()),
-        Some(o) => Ok(extras_from_analysis(&kappe::constraints::analyze(
-            cap,
-            o,
-            &|_| {},
-        )?)),
+    plan_robot: bool,
+    on_fe: &(dyn Fn(usize) + Sync),
+    before_plan: &dyn Fn(),
+) -> Result<Evaluation, kappe::DesignError> {
+    let analysis = match options {
+        Some(o) => Some(kappe::constraints::analyze(cap, o, on_fe)?),
+        None => None,
+    };
+    let mut extras = analysis
+        .as_ref()
+        .map(extras_from_analysis)
+        .unwrap_or_default();
+    let robot = plan_robot.then(|| {
+        before_plan();
+        kappe::robot_plan::plan_robot(cap)
+    });
+    if let Some(plan) = &robot {
+        add_robot(&mut extras, plan);
     }
+    let ok = design_ok(cap, &extras);
+    Ok(Evaluation {
+        analysis,
+        robot,
+        extras,
+        ok,
+    })
+}
+
+impl Evaluation {
+    /// `summary.json`: the cap's summary with the analysis merged in, the robot block
+    /// (stations with `world_from_base`, `flange_from_tcp`, motion, time, clearance; or why it
+    /// failed) and the verdict `ok`.
+    pub fn summary(&self, cap: &Cap) -> serde_json::Value {
+        let mut summary = kappe::export::summary_json(cap);
+        if let Some(analysis) = &self.analysis {
+            kappe::export::add_analysis(&mut summary, analysis);
+        }
+        let robot = match &self.robot {
+            None => serde_json::json!({"planned": false, "reason": "disabled"}),
+            Some(Ok(plan)) => plan_summary(plan),
+            Some(Err(e)) => {
+                serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
+            }
+        };
+        if let Some(obj) = summary.as_object_mut() {
+            obj.insert("robot".into(), robot);
+            obj.insert("ok".into(), serde_json::json!(self.ok));
+        }
+        summary
+    }
+}
+
+/// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
+fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
+    serde_json::json!({
+        "planned": true,
+        "ok": true,
+        "stations": plan.stations.iter().map(|s| serde_json::json!({
+            "world_from_base": s.world_from_base,
+            "layers": s.layers.iter().map(|l| l.layer).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "flange_from_tcp": plan.flange_from_tcp,
+        "joint_motion_rad": plan.joint_motion,
+        "cost_rad2": plan.cost,
+        "print_time_s": plan.print_time,
+        "total_time_s": plan.total_time,
+        "min_clearance_m": plan.min_clearance,
+        "min_self_distance_m": plan.min_self_distance,
+        "max_speed_ratio": plan.max_speed_ratio,
+    })
 }
 
 /// The analysis of `kappe::constraints::analyze` as report extras: per-state BLF and verdict,
 /// the constraint rows in the report's units (stresses in kPa, overhang in mm; the analysis
 /// gives Pa and m), and the overall verdict. A constraint that no state was checked for (e.g.
 /// `blf_min` with buckling switched off) has no worst value and is left out of the table.
-#[allow(
-    dead_code,
-    reason = "called from `analyse` once the analysis is switched on (lead)"
-)]
 pub fn extras_from_analysis(analysis: &kappe::constraints::Analysis) -> ReportExtras {
     let states = analysis
         .states

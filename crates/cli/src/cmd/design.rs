@@ -73,52 +73,36 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         options.buckling = false;
     }
     let fe_bar = state_bar("analysis", silent);
-    let analysis = kappe::constraints::analyze(&cap, &options, &|total| tick(&fe_bar, total))?;
-    fe_bar.finish_and_clear();
-
-    // Robot: plan (verified inside the planner) unless disabled.
-    let robot = if cap.design.robot.enabled && !args.no_robot {
-        let spinner = if silent {
-            ProgressBar::hidden()
-        } else {
-            ProgressBar::new_spinner()
-        };
-        spinner.set_message("planning the UR10e trajectory");
-        spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-        let plan = kappe::robot_plan::plan_robot(&cap);
-        spinner.finish_and_clear();
-        Some(plan)
+    let spinner = if silent {
+        ProgressBar::hidden()
     } else {
-        None
+        ProgressBar::new_spinner()
     };
+    // Robot: planned (and verified inside the planner) unless disabled.
+    let eval = crate::report_input::evaluate(
+        &cap,
+        Some(&options),
+        cap.design.robot.enabled && !args.no_robot,
+        &|total| tick(&fe_bar, total),
+        &|| {
+            fe_bar.finish_and_clear();
+            spinner.set_message("planning the UR10e trajectory");
+            spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+        },
+    )?;
+    fe_bar.finish_and_clear();
+    spinner.finish_and_clear();
+    let (analysis, robot, ok) = (&eval.analysis, &eval.robot, eval.ok);
     let mut programs: Vec<String> = Vec::new();
     let mut trajectory: Vec<u8> = Vec::new();
     let mut program: Vec<u8> = Vec::new();
-    let robot_json = match &robot {
-        None => serde_json::json!({"planned": false, "reason": "disabled"}),
-        Some(Ok(plan)) => {
-            kappe_robot::write_trajectory_csv(plan, &mut trajectory)?;
-            kappe_robot::write_urscript(plan, &mut program)?;
-            programs = kappe_robot::urscript_programs(plan)?;
-            plan_summary(plan)
-        }
-        Some(Err(e)) => {
-            serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
-        }
-    };
-    let mut extras = crate::report_input::extras_from_analysis(&analysis);
-    if let Some(plan) = &robot {
-        crate::report_input::add_robot(&mut extras, plan);
+    if let Some(Ok(plan)) = robot {
+        kappe_robot::write_trajectory_csv(plan, &mut trajectory)?;
+        kappe_robot::write_urscript(plan, &mut program)?;
+        programs = kappe_robot::urscript_programs(plan)?;
     }
-    let ok = crate::report_input::design_ok(&cap, &extras);
-    let report = kappe_report::render_html(&crate::report_input::report_input(&cap, &extras))?;
-
-    let mut summary = kappe::export::summary_json(&cap);
-    kappe::export::add_analysis(&mut summary, &analysis);
-    if let Some(obj) = summary.as_object_mut() {
-        obj.insert("robot".into(), robot_json);
-        obj.insert("ok".into(), serde_json::json!(ok));
-    }
+    let report = kappe_report::render_html(&crate::report_input::report_input(&cap, &eval.extras))?;
+    let summary = eval.summary(&cap);
     let network = kappe::export::network_json(&cap)?;
     write_dir_atomic(&args.out, |dir| {
         std::fs::write(
@@ -152,7 +136,9 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if !args.quiet {
         print_table(&cap, &args.out);
-        print!("{}", indent(&analysis.report()));
+        if let Some(analysis) = analysis {
+            print!("{}", indent(&analysis.report()));
+        }
         match &robot {
             Some(Ok(plan)) => println!(
                 "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm; \
@@ -171,7 +157,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         eprintln!("error: the robot cannot print this design: {e}");
     }
     if !ok {
-        for c in analysis.failing() {
+        for c in analysis.iter().flat_map(|a| a.failing()) {
             eprintln!(
                 "error: constraint {} fails: worst {} {} against the limit {} {}{}",
                 c.name,
@@ -213,26 +199,6 @@ fn tick(bar: &ProgressBar, total: usize) {
 
 fn indent(text: &str) -> String {
     text.lines().map(|l| format!("  {l}\n")).collect()
-}
-
-/// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
-fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
-    serde_json::json!({
-        "planned": true,
-        "ok": true,
-        "stations": plan.stations.iter().map(|s| serde_json::json!({
-            "world_from_base": s.world_from_base,
-            "layers": s.layers.iter().map(|l| l.layer).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-        "flange_from_tcp": plan.flange_from_tcp,
-        "joint_motion_rad": plan.joint_motion,
-        "cost_rad2": plan.cost,
-        "print_time_s": plan.print_time,
-        "total_time_s": plan.total_time,
-        "min_clearance_m": plan.min_clearance,
-        "min_self_distance_m": plan.min_self_distance,
-        "max_speed_ratio": plan.max_speed_ratio,
-    })
 }
 
 fn print_table(cap: &kappe::Cap, out: &std::path::Path) {

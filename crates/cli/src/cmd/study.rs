@@ -63,7 +63,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::output::write_dir_atomic;
-use crate::report_input::{add_robot, analyse, design_ok, report_input};
+use crate::report_input::{evaluate, report_input};
 
 /// `kappe study`: run a study file, or merge shards.
 #[derive(Args)]
@@ -615,7 +615,6 @@ fn failed_record(v: &Variation, parameters: Vec<String>, reason: String) -> Reco
     }
 }
 
-/// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
 /// What is run for every design besides `design_cap`.
 #[derive(Debug, Clone, Copy)]
 struct Steps<'a> {
@@ -625,6 +624,7 @@ struct Steps<'a> {
     robot: bool,
 }
 
+/// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
 fn run_one(v: &Variation, parameter_paths: &[String], steps: Steps, root: &Path) -> Record {
     let parameters: Vec<String> = parameter_paths
         .iter()
@@ -660,18 +660,17 @@ fn run_one(v: &Variation, parameter_paths: &[String], steps: Steps, root: &Path)
     };
     let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| -> Result<Record> {
         let cap = kappe::design_cap(design, &|_| {})?;
-        let mut extras = analyse(&cap, steps.analysis)?;
-        let robot = if steps.robot && cap.design.robot.enabled {
-            let plan = kappe::robot_plan::plan_robot(&cap);
-            add_robot(&mut extras, &plan);
-            Some(extras.robot_error.clone())
-        } else {
-            None
-        };
-        let ok = design_ok(&cap, &extras);
-        let input = report_input(&cap, &extras);
+        let plan = steps.robot && cap.design.robot.enabled;
+        let eval = evaluate(&cap, steps.analysis, plan, &|_| {}, &|| {})?;
+        let extras = &eval.extras;
+        let robot = eval
+            .robot
+            .as_ref()
+            .map(|r| r.as_ref().err().map(ToString::to_string));
+        let ok = eval.ok;
+        let input = report_input(&cap, extras);
         let html = kappe_report::render_html(&input).context("cannot render the report")?;
-        let summary = kappe::export::summary_json(&cap);
+        let summary = eval.summary(&cap);
         std::fs::write(
             dir.join("summary.json"),
             serde_json::to_vec_pretty(&summary)?,
