@@ -102,14 +102,12 @@ fn summarize(state: &State, topo: &Topology, fp: &ForcePass, areas: Sections2D) 
             hv_max = hv_max.max(hv);
         }
     }
-    let starts: Vec<f64> = state
+    let fmin = state.factors.iter().copied().fold(f64::INFINITY, f64::min);
+    let fmax = state
         .factors
         .iter()
-        .zip(&state.column_force_per_weight)
-        .map(|(d, _)| *d)
-        .collect();
-    let fmin = starts.iter().copied().fold(f64::INFINITY, f64::min);
-    let fmax = starts.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        .copied()
+        .fold(f64::NEG_INFINITY, f64::max);
     StateForces {
         max_compression_force: cmin,
         max_tension_force: cmax,

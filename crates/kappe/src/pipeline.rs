@@ -107,24 +107,27 @@ pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<
     let phi = design.print.start_arch_fraction;
     let area = areas(design, &arch);
     let total = sections.layers.len();
-    let summaries: Vec<StateSummary> = (0..total)
+    let solve = |top: usize| {
+        let state = build_state(&sections, &frame, phi, top)?;
+        let (topology, pass, forces) = state_forces(&state, area)?;
+        on_state(total);
+        let summary = StateSummary {
+            index: state.index,
+            progress: state.progress,
+            layers_printed: state.layers_printed,
+            top_layer: state.top_layer,
+            nodes: state.network.nodes.len(),
+            forces,
+        };
+        Ok::<_, DesignError>((state, topology, pass, summary))
+    };
+    // Every state but the last keeps only its summary; the final one keeps its network too.
+    let mut summaries: Vec<StateSummary> = (0..total - 1)
         .into_par_iter()
-        .map(|top| {
-            let state = build_state(&sections, &frame, phi, top)?;
-            let (_, _, forces) = state_forces(&state, area)?;
-            on_state(total);
-            Ok(StateSummary {
-                index: state.index,
-                progress: state.progress,
-                layers_printed: state.layers_printed,
-                top_layer: state.top_layer,
-                nodes: state.network.nodes.len(),
-                forces,
-            })
-        })
+        .map(|top| solve(top).map(|(_, _, _, summary)| summary))
         .collect::<Result<_, DesignError>>()?;
-    let final_state = build_state(&sections, &frame, phi, total - 1)?;
-    let (final_topology, final_forces, _) = state_forces(&final_state, area)?;
+    let (final_state, final_topology, final_forces, final_summary) = solve(total - 1)?;
+    summaries.push(final_summary);
     let path = print_path(
         &sections,
         &frame,

@@ -154,16 +154,11 @@ pub fn build_state(
     // Nodes, layer by layer, top-down.
     let mut nodes = Vec::new();
     let mut deviation_edges = Vec::new();
-    // column id → node indices top-down
+    // Column ids are the indices of layer 0's nodes; node indices of each column, top-down.
     let n_cols = sections
-        .layers
-        .iter()
-        .flat_map(|l| l.nodes.iter())
-        .filter_map(|n| match n.kind {
-            NodeKind::Column(i) => Some(i + 1),
-            NodeKind::Foot => None,
-        });
-    let n_cols = n_cols.max().unwrap_or(0);
+        .print_index(0)
+        .and_then(|q| sections.layers.get(q))
+        .map_or(0, |l| l.nodes.len());
     let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n_cols];
     let mut last_layer_of_col: Vec<Option<usize>> = vec![None; n_cols];
     for q in (0..=top).rev() {
