@@ -139,11 +139,9 @@ pub fn layer_topology(
     mu: f64,
 ) -> kappe_cem::Topology {
     use kappe_cem::topology::{DeviationEdge, Node, Topology, TrailEdge};
-    let frame = LayerFrame::new(spec.tilt);
     let w = spec.specific_weight * spec.layer_width * spec.layer_height * s;
     let load = V3::new(0.0, w * spec.tilt.tan(), -w);
     let crown_y = -spec.rise * spec.tilt.tan();
-    let _ = frame;
     let mut nodes = Vec::with_capacity(2 * nt + 2);
     let mut trail_edges = Vec::with_capacity(2 * nt);
     for side in 0..2u64 {
