@@ -12,8 +12,8 @@
 //!   on the base plane.
 //! - `states`: one per `cap.states`, with σ_min/σ_max of the force pass, the largest |l_o| of the
 //!   printed layers and, while the page stays small, per-state segment stresses
-//!   `F_i · d_q(state) / (lw·lh)` (the factors of every state are rebuilt with
-//!   [`kappe::states::build_state`]; they differ from the final ones only in the start section).
+//!   `F_i · d_q(state) / (lw·lh)` (the factors of every state, kept by `design_cap`; they
+//!   differ from the final ones only in the start section).
 //! - `constraints`: [`preliminary_constraints`] (σ_min, σ_max, overhang, worst over all states),
 //!   then the analysis rows of [`ReportExtras::constraints`], which replace rows of the same
 //!   name and add new ones (BLF, robot reach, …).
@@ -474,8 +474,7 @@ fn parameters(cap: &Cap) -> Vec<Parameter> {
 }
 
 /// Per-state segment stresses: the printed layers' segments, concatenated in print order, with
-/// that state's layer factors. `None` when a state cannot be rebuilt (it was built once already
-/// by `design_cap`, so this does not happen for a finished cap) or the total is too large.
+/// that state's layer factors (kept by `design_cap`). `None` when the total is too large.
 fn state_segment_stresses(cap: &Cap, area: f64) -> Option<Vec<Vec<f64>>> {
     let seg_counts: Vec<usize> = cap
         .sections
@@ -491,18 +490,18 @@ fn state_segment_stresses(cap: &Cap, area: f64) -> Option<Vec<Vec<f64>>> {
     if total > MAX_STATE_STRESS_VALUES {
         return None;
     }
-    let phi = cap.design.print.start_arch_fraction;
-    cap.states
+    let per_state = cap
+        .states
         .iter()
         .map(|s| {
-            let state = kappe::states::build_state(&cap.sections, &cap.frame, phi, s.index).ok()?;
             let mut out = Vec::new();
-            for (layer, d) in cap.sections.layers.iter().zip(&state.factors) {
+            for (layer, d) in cap.sections.layers.iter().zip(&s.factors) {
                 out.extend(layer.segment_forces.iter().map(|f| f * d / area));
             }
-            Some(out)
+            out
         })
-        .collect()
+        .collect();
+    Some(per_state)
 }
 
 /// Maps a designed cap (plus optional analysis and robot results) to the report input.

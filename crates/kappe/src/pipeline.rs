@@ -27,6 +27,9 @@ pub struct StateSummary {
     pub top_layer: i32,
     /// Nodes in the state network.
     pub nodes: usize,
+    /// Layer factor d of every printed layer, in print order (1 for centre layers).
+    #[serde(skip)]
+    pub factors: Vec<f64>,
     /// Forces, stresses, residual and reactions.
     #[serde(flatten)]
     pub forces: StateForces,
@@ -117,6 +120,7 @@ pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<
             layers_printed: state.layers_printed,
             top_layer: state.top_layer,
             nodes: state.network.nodes.len(),
+            factors: state.factors.clone(),
             forces,
         };
         Ok::<_, DesignError>((state, topology, pass, summary))
