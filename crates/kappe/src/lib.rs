@@ -8,6 +8,7 @@
 
 pub mod analysis;
 pub mod arch;
+pub mod buildability;
 pub mod calibrate;
 pub mod constraints;
 pub mod design_loop;
@@ -15,10 +16,13 @@ pub mod error;
 pub mod export;
 pub mod forces;
 pub mod frame;
+pub mod green;
+pub mod material;
 pub mod mesh;
 pub mod path;
 pub mod pipeline;
 pub mod robot_plan;
+pub mod schedule;
 pub mod section;
 pub mod shell;
 pub mod spec;

@@ -1,0 +1,299 @@
+//! The green-state check of one print state on its shell model (green-state.md §1, §3): the
+//! three failure modes of fresh printed material, each with the age of the layers involved.
+//!
+//! The same function checks the cap's states and the buildability test objects; only the mesh
+//! differs. Given the state's shell model, the age of every printed layer and the time model
+//! ([`crate::material::TimeModel`]):
+//! - **Elastic buckling.** E of every element from its layers' ages (an element joining two
+//!   layers takes the mean of their moduli); the lowest positive linear buckling factor under
+//!   self-weight must reach `blf_min` (1 for a real material: the load factor at which the
+//!   state buckles).
+//! - **Strength (plastic collapse).** Mohr–Coulomb on the membrane stresses σ = N/t of every
+//!   element at its centroid (CST: constant per element), with c(t), φ(t) at the age of the
+//!   younger layer the element touches. Utilisation 1 = yield; uniaxial compression −f_c gives
+//!   exactly 1. Why Mohr–Coulomb: see [`crate::material`].
+//! - **Bed-joint sliding.** The traction of the membrane stress tensor S (3×3, global) on the
+//!   bed plane with unit normal n (the plane of the layer above the joint): σ_n = n·S·n,
+//!   τ = |S·n − σ_n·n|, checked as |τ| ≤ c(t) + (−σ_n)·tan φ(t) with the younger layer's age.
+//!   In the cap's centre section the leaning layer gives τ/σ_n = tan am (method.md §5).
+//!
+//! The membrane stresses come from the linear static solution that the buckling solve computes
+//! anyway, so strength and sliding cost nothing extra when buckling is checked.
+
+use kappe_fe::{BucklingOptions, FeError, Material, ShellModel};
+use serde::Serialize;
+
+use crate::error::DesignError;
+use crate::material::TimeModel;
+
+/// Which layers an element belongs to, by print index (0 = first printed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementLayers {
+    /// The two layers whose moduli the element averages (equal for an element inside one
+    /// layer).
+    pub stiffness: (usize, usize),
+    /// The younger layer the element touches: its age sets the strength and the joint's
+    /// strength.
+    pub younger: usize,
+    /// Unit normal of the bed plane through the element (global frame).
+    pub bed_normal: [f64; 3],
+}
+
+/// Options of [`check_state`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GreenOptions {
+    /// Smallest admissible buckling factor.
+    pub blf_min: f64,
+    /// Check buckling.
+    pub buckling: bool,
+    /// Check strength (needs a strength model).
+    pub strength: bool,
+    /// Check bed-joint sliding (needs a strength model).
+    pub sliding: bool,
+    /// Relative tolerance of the Lanczos solve.
+    pub tolerance: f64,
+}
+
+impl Default for GreenOptions {
+    fn default() -> Self {
+        GreenOptions {
+            blf_min: 1.0,
+            buckling: true,
+            strength: true,
+            sliding: true,
+            // The factor is compared with a threshold; 1e-8 relative is far below any
+            // modelling error (as in the cap's analysis).
+            tolerance: 1e-8,
+        }
+    }
+}
+
+/// The failure modes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureMode {
+    /// Elastic buckling: BLF < BLF_min.
+    Buckling,
+    /// Plastic collapse: Mohr–Coulomb utilisation > 1.
+    Strength,
+    /// Bed-joint sliding: |τ| > c + σ_n·tan φ.
+    Sliding,
+}
+
+impl FailureMode {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            FailureMode::Buckling => "buckling",
+            FailureMode::Strength => "strength",
+            FailureMode::Sliding => "sliding",
+        }
+    }
+}
+
+/// The worst element of one check.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct WorstElement {
+    /// Utilisation (demand / capacity; > 1 fails).
+    pub utilisation: f64,
+    /// Element index in the state's shell model.
+    pub element: usize,
+    /// The younger layer at the element (print index).
+    pub layer: usize,
+    /// Its age, s.
+    pub age_s: f64,
+    /// Membrane stresses there, Pa: for strength the principal stresses (σ₁ ≥ σ₂), for sliding
+    /// (σ_n, τ) on the bed plane; tension positive.
+    pub stresses: [f64; 2],
+}
+
+/// What the buckling check did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "status")]
+pub enum BucklingOutcome {
+    /// Not checked.
+    Skipped,
+    /// Lowest positive factor.
+    Factor {
+        /// BLF.
+        blf: f64,
+    },
+    /// No positive factor: the load cannot buckle the state.
+    NoPositiveFactor,
+    /// The shell is a mechanism (BLF 0).
+    Mechanism {
+        /// Where.
+        message: String,
+    },
+}
+
+/// The check of one state.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct GreenState {
+    /// Buckling.
+    pub buckling: BucklingOutcome,
+    /// Worst strength utilisation (None: not checked).
+    pub strength: Option<WorstElement>,
+    /// Worst bed-joint sliding utilisation (None: not checked).
+    pub sliding: Option<WorstElement>,
+    /// The failing check with the largest utilisation (None: the state stands).
+    pub failure: Option<FailureMode>,
+    /// The check with the largest utilisation, failing or not (BLF_min/BLF for buckling).
+    pub governing: Option<FailureMode>,
+}
+
+impl GreenState {
+    /// BLF if one was found (0 for a mechanism).
+    pub fn blf(&self) -> Option<f64> {
+        match &self.buckling {
+            BucklingOutcome::Factor { blf } => Some(*blf),
+            BucklingOutcome::Mechanism { .. } => Some(0.0),
+            _ => None,
+        }
+    }
+}
+
+/// Check one state (see the module docs). `model` holds the geometry, thickness, supports and
+/// the base material (ν, γ); its materials are replaced by the aged ones. `ages[k]` is the age of
+/// the layer with print index k, s.
+pub fn check_state(
+    model: &mut ShellModel,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &GreenOptions,
+) -> Result<GreenState, DesignError> {
+    let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
+    let base = model.material_of(0);
+    if !time.is_constant() {
+        model.materials = elements
+            .iter()
+            .map(|e| Material {
+                youngs_modulus: 0.5
+                    * (time.modulus(age(e.stiffness.0)) + time.modulus(age(e.stiffness.1))),
+                ..base
+            })
+            .collect();
+    }
+    let want_stress = (options.strength || options.sliding) && time.strength.is_some();
+    let (buckling, static_result) = if options.buckling {
+        let opts = BucklingOptions {
+            modes: 1,
+            tolerance: options.tolerance,
+            sturm_check: false,
+            ..Default::default()
+        };
+        match kappe_fe::buckling(model, &opts) {
+            Ok(r) => {
+                let b = match r.factors.first() {
+                    Some(&blf) => BucklingOutcome::Factor { blf },
+                    None => BucklingOutcome::NoPositiveFactor,
+                };
+                (b, Some(r.static_result))
+            }
+            Err(FeError::Mechanism { free_dofs }) => {
+                let dofs: Vec<String> = free_dofs.iter().take(4).map(|d| d.to_string()).collect();
+                (
+                    BucklingOutcome::Mechanism {
+                        message: format!("mechanism (free DOFs: {})", dofs.join(", ")),
+                    },
+                    None,
+                )
+            }
+            Err(e) => return Err(fe_error(e)),
+        }
+    } else if want_stress {
+        (
+            BucklingOutcome::Skipped,
+            Some(kappe_fe::linear_static(model).map_err(fe_error)?),
+        )
+    } else {
+        (BucklingOutcome::Skipped, None)
+    };
+
+    let mut strength: Option<WorstElement> = None;
+    let mut sliding: Option<WorstElement> = None;
+    if let (true, Some(st)) = (want_stress, &static_result) {
+        for (i, (res, info)) in st.elements.iter().zip(elements).enumerate() {
+            let t = age(info.younger);
+            let Some(mc) = time.mohr_coulomb(t) else {
+                continue;
+            };
+            let [sx, sy, sxy] = res.membrane_stress();
+            if options.strength {
+                let (s1, s2) = principal(sx, sy, sxy);
+                let u = mc.utilisation(s1, s2);
+                if strength.is_none_or(|w| u > w.utilisation) {
+                    strength = Some(WorstElement {
+                        utilisation: u,
+                        element: i,
+                        layer: info.younger,
+                        age_s: t,
+                        stresses: [s1, s2],
+                    });
+                }
+            }
+            if options.sliding {
+                let (sn, tau) = bed_traction(&res.frame, [sx, sy, sxy], info.bed_normal);
+                let u = mc.sliding_utilisation(tau, sn);
+                if sliding.is_none_or(|w| u > w.utilisation) {
+                    sliding = Some(WorstElement {
+                        utilisation: u,
+                        element: i,
+                        layer: info.younger,
+                        age_s: t,
+                        stresses: [sn, tau],
+                    });
+                }
+            }
+        }
+    }
+
+    let buckling_u = match &buckling {
+        BucklingOutcome::Factor { blf } => Some(options.blf_min / blf),
+        BucklingOutcome::Mechanism { .. } => Some(f64::INFINITY),
+        _ => None,
+    };
+    let candidates = [
+        (FailureMode::Buckling, buckling_u),
+        (FailureMode::Strength, strength.map(|w| w.utilisation)),
+        (FailureMode::Sliding, sliding.map(|w| w.utilisation)),
+    ];
+    let governing = candidates
+        .iter()
+        .filter_map(|(m, u)| u.map(|u| (*m, u)))
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    let failure = governing.filter(|(_, u)| *u > 1.0).map(|g| g.0);
+    Ok(GreenState {
+        buckling,
+        strength,
+        sliding,
+        failure,
+        governing: governing.map(|g| g.0),
+    })
+}
+
+fn fe_error(e: FeError) -> DesignError {
+    DesignError::FormFinding(format!("green-state shell analysis: {e}"))
+}
+
+/// In-plane principal stresses (σ₁ ≥ σ₂) of a plane stress state.
+pub fn principal(sx: f64, sy: f64, sxy: f64) -> (f64, f64) {
+    let m = 0.5 * (sx + sy);
+    let r = (0.25 * (sx - sy).powi(2) + sxy * sxy).sqrt();
+    (m + r, m - r)
+}
+
+/// Normal stress and shear magnitude of the membrane stress `[σx, σy, τxy]` (element frame with
+/// rows e1, e2, e3) on the plane with global unit normal `n`.
+pub fn bed_traction(frame: &[[f64; 3]; 3], s: [f64; 3], n: [f64; 3]) -> (f64, f64) {
+    let dot = |a: &[f64; 3], b: &[f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    // n in the element frame; the out-of-plane component carries no membrane stress.
+    let (n1, n2) = (dot(&frame[0], &n), dot(&frame[1], &n));
+    let t1 = s[0] * n1 + s[2] * n2;
+    let t2 = s[2] * n1 + s[1] * n2;
+    let traction: [f64; 3] = std::array::from_fn(|k| t1 * frame[0][k] + t2 * frame[1][k]);
+    let sn = dot(&traction, &n);
+    let shear: [f64; 3] = std::array::from_fn(|k| traction[k] - sn * n[k]);
+    (sn, dot(&shear, &shear).sqrt())
+}
