@@ -341,6 +341,7 @@ pub fn demo_input() -> ReportInput {
         joints: Vec::new(),
         link_radii: RADII.to_vec(),
         poses: Vec::new(),
+        ..RobotAnimation::default()
     };
     let mut q = [-FRAC_PI_2, -1.2, 1.6];
     // Converge on the first path point before recording, so the animation starts settled.
@@ -485,5 +486,6 @@ pub fn demo_input() -> ReportInput {
         constraints,
         robot: Some(robot),
         plots: Vec::new(),
+        ..ReportInput::default()
     }
 }

@@ -21,7 +21,10 @@ use crate::error::ReportError;
 pub type Vec3 = [f64; 3];
 
 /// Everything the report shows. See the module docs for units and conventions.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// The fields after `plots` are optional (serde defaults; build with `..Default::default()`),
+/// so callers that do not have a robot plan or an analysis still fill the page.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct ReportInput {
     /// Design name, shown as the page title.
     pub name: String,
@@ -41,6 +44,147 @@ pub struct ReportInput {
     pub robot: Option<RobotAnimation>,
     /// Extra plots shown after the standard ones (which are derived from the fields above).
     pub plots: Vec<Plot>,
+    /// When each print-path point is printed, on the robot's clock: the page's one timeline.
+    /// `None`: the viewer uses the path's arc length at 1 m per time unit.
+    #[serde(default)]
+    pub timeline: Option<Timeline>,
+    /// The robot cell: stations (base poses), tool, mobile base, beams, floor. With a cell and
+    /// [`RobotAnimation::station`] the viewer draws the UR10e from its meshes.
+    #[serde(default)]
+    pub cell: Option<Cell>,
+    /// First buckling mode of the states that have one.
+    #[serde(default)]
+    pub modes: Vec<ModeShape>,
+    /// Where each constraint is worst, for the markers in 3D.
+    #[serde(default)]
+    pub worst_places: Vec<WorstPlace>,
+    /// More quantities to colour the beads by and to plot (layer age, stiffness, …); each one
+    /// appears in the colour menu and gets a min/max-over-progress plot.
+    #[serde(default)]
+    pub quantities: Vec<Quantity>,
+}
+
+/// The print on one clock: when the nozzle reaches each print-path point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Timeline {
+    /// Time at which `print_path.points[i]` is printed, s; non-decreasing, same length.
+    pub point_time: Vec<f64>,
+    /// End of the timeline, s (≥ the last point time, e.g. the robot plan's end).
+    pub total_time: f64,
+}
+
+/// One base pose of the mobile robot and the layers printed from it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Station {
+    /// Robot base pose (DH frame 0 = ROS `base`) in the world, row-major 4×4, m.
+    pub world_from_base: [[f64; 4]; 4],
+    /// Ids of the layers printed from this station.
+    pub layers: Vec<i32>,
+}
+
+/// A box: centre, half extents and a rotation about z.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct BoxBody {
+    /// Name shown on hover, e.g. `beam_left`.
+    pub name: String,
+    /// Centre, m.
+    pub center: Vec3,
+    /// Half extents along the box axes, m.
+    pub half_extents: Vec3,
+    /// Rotation about z, rad.
+    #[serde(default)]
+    pub yaw: f64,
+}
+
+/// A capsule (cylinder with round ends) from `a` to `b`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Capsule {
+    /// One end, m.
+    pub a: Vec3,
+    /// The other end, m.
+    pub b: Vec3,
+    /// Radius, m.
+    pub radius: f64,
+}
+
+/// The robot cell around the print.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Cell {
+    /// Base stations in the order the robot uses them.
+    pub stations: Vec<Station>,
+    /// TCP (nozzle tip) in the flange frame (ROS `tool0`), row-major 4×4.
+    pub flange_from_tcp: [[f64; 4]; 4],
+    /// The tool body as capsules in the flange frame.
+    pub tool: Vec<Capsule>,
+    /// Mobile-base body boxes in the robot base frame (they move with the base).
+    pub mobile_base: Vec<BoxBody>,
+    /// Static obstacles in the world (the beams under the springing lines).
+    pub obstacles: Vec<BoxBody>,
+    /// Floor height in the world, m.
+    pub floor_z: Option<f64>,
+}
+
+/// The first buckling mode of one state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct ModeShape {
+    /// Position of the state in [`ReportInput::states`].
+    pub state: usize,
+    /// Its buckling load factor.
+    pub blf: f64,
+    /// Displacement of every bead node of the state's printed layers (the `nodes` of the first
+    /// `layers_printed` layers, concatenated), any scale (the viewer normalises it).
+    pub displacement: Vec<Vec3>,
+}
+
+/// Where a constraint reaches its worst value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct WorstPlace {
+    /// Name of the constraint row.
+    pub constraint: String,
+    /// Position of the state in [`ReportInput::states`], if state-dependent.
+    pub state: Option<usize>,
+    /// Layer id, if the place is in one layer.
+    pub layer: Option<i32>,
+    /// The place, m.
+    pub position: Vec3,
+    /// The signed worst value in the row's unit, when the row shows a magnitude.
+    pub signed_value: Option<f64>,
+}
+
+/// What a [`Quantity`] has one value per.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum QuantityPer {
+    /// One value per bead segment (the `segment_stress` layout).
+    #[default]
+    Segment,
+    /// One value per layer.
+    Layer,
+}
+
+/// A quantity to colour the beads by.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct Quantity {
+    /// Stable key, e.g. `layer_age`.
+    pub key: String,
+    /// Menu and legend label, e.g. `layer age`.
+    pub label: String,
+    /// Unit shown, e.g. `min`.
+    pub unit: String,
+    /// Shown value = value × `to_unit` (e.g. 1/60 for s → min).
+    pub to_unit: f64,
+    /// Per segment or per layer.
+    pub per: QuantityPer,
+    /// Diverging colours about zero (signed quantities) instead of a sequential ramp.
+    #[serde(default)]
+    pub diverging: bool,
+    /// Values per state (same order as [`ReportInput::states`]), each covering that state's
+    /// printed layers in print order; or exactly one entry covering every layer, used for
+    /// every state (a final-state quantity).
+    pub states: Vec<Vec<f64>>,
+    /// A short note under the legend on how to read it.
+    #[serde(default)]
+    pub note: Option<String>,
 }
 
 /// One row of the parameters table.
@@ -170,8 +314,9 @@ pub struct ConstraintRow {
 ///
 /// The CLI computes the link segments with forward kinematics; the viewer draws link `j` at
 /// time step `i` as a cylinder of radius `link_radii[j]` from `poses[i][j][0]` to
-/// `poses[i][j][1]`, with a sphere at each end (a capsule).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// `poses[i][j][1]`, with a sphere at each end (a capsule). With a [`Cell`] and `station` the
+/// viewer draws the UR10e meshes from `joints` instead, and `poses` may be empty.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct RobotAnimation {
     /// Time of each step, s, non-decreasing.
     pub times: Vec<f64>,
@@ -179,8 +324,12 @@ pub struct RobotAnimation {
     pub joints: Vec<[f64; 6]>,
     /// Radius of each link capsule, m.
     pub link_radii: Vec<f64>,
-    /// Per time step, the world end points of each link segment, m: `link_radii.len()` per step.
+    /// Per time step, the world end points of each link segment, m: `link_radii.len()` per step
+    /// (or empty when the viewer poses the meshes of [`ReportInput::cell`]).
     pub poses: Vec<Vec<[Vec3; 2]>>,
+    /// Station (index into [`Cell::stations`]) of each step; empty when there is one station.
+    #[serde(default)]
+    pub station: Vec<usize>,
 }
 
 /// A line plot rendered as inline SVG.
@@ -304,8 +453,9 @@ impl ReportInput {
             finite(|| format!("constraints[{ci}].worst"), c.worst)?;
         }
         if let Some(robot) = &self.robot {
-            robot.validate()?;
+            robot.validate(self.cell.as_ref())?;
         }
+        self.validate_extras()?;
         for (pi, plot) in self.plots.iter().enumerate() {
             for (si, s) in plot.series.iter().enumerate() {
                 for (k, xy) in s.points.iter().enumerate() {
@@ -393,14 +543,221 @@ impl ReportInput {
     }
 }
 
+impl ReportInput {
+    /// Node count of the first `printed` layers.
+    pub(crate) fn printed_nodes(&self, printed: usize) -> usize {
+        self.layers
+            .iter()
+            .take(printed)
+            .map(|l| l.nodes.len())
+            .sum()
+    }
+
+    /// Segment count of the first `printed` layers.
+    pub(crate) fn printed_segments(&self, printed: usize) -> usize {
+        self.layers
+            .iter()
+            .take(printed)
+            .map(|l| l.segment_stress.len())
+            .sum()
+    }
+
+    fn validate_extras(&self) -> Result<(), ReportError> {
+        if let Some(t) = &self.timeline {
+            let n = self.print_path.points.len();
+            if t.point_time.len() != n {
+                return Err(mismatch(
+                    "timeline.point_time".into(),
+                    t.point_time.len(),
+                    n,
+                ));
+            }
+            let mut last = f64::NEG_INFINITY;
+            for (i, &v) in t.point_time.iter().enumerate() {
+                finite(|| format!("timeline.point_time[{i}]"), v)?;
+                if v < last {
+                    return Err(ReportError::OutOfRange {
+                        field: format!("timeline.point_time[{i}]"),
+                        value: v,
+                        allowed: "times non-decreasing",
+                    });
+                }
+                last = v;
+            }
+            if !t.total_time.is_finite() || t.total_time < last.max(0.0) {
+                return Err(ReportError::OutOfRange {
+                    field: "timeline.total_time".into(),
+                    value: t.total_time,
+                    allowed: "finite and at least the last point time",
+                });
+            }
+        }
+        if let Some(cell) = &self.cell {
+            let mats = cell
+                .stations
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    (
+                        format!("cell.stations[{i}].world_from_base"),
+                        s.world_from_base,
+                    )
+                })
+                .chain(std::iter::once((
+                    "cell.flange_from_tcp".to_string(),
+                    cell.flange_from_tcp,
+                )));
+            for (name, m) in mats {
+                for (r, row) in m.iter().enumerate() {
+                    for (c, v) in row.iter().enumerate() {
+                        finite(|| format!("{name}[{r}][{c}]"), *v)?;
+                    }
+                }
+            }
+            for (i, c) in cell.tool.iter().enumerate() {
+                finite3(|| format!("cell.tool[{i}].a"), &c.a)?;
+                finite3(|| format!("cell.tool[{i}].b"), &c.b)?;
+                if !(c.radius.is_finite() && c.radius > 0.0) {
+                    return Err(ReportError::OutOfRange {
+                        field: format!("cell.tool[{i}].radius"),
+                        value: c.radius,
+                        allowed: "a finite radius > 0 m",
+                    });
+                }
+            }
+            let boxes = cell
+                .mobile_base
+                .iter()
+                .enumerate()
+                .map(|(i, b)| (format!("cell.mobile_base[{i}]"), b))
+                .chain(
+                    cell.obstacles
+                        .iter()
+                        .enumerate()
+                        .map(|(i, b)| (format!("cell.obstacles[{i}]"), b)),
+                );
+            for (name, b) in boxes {
+                finite3(|| format!("{name}.center"), &b.center)?;
+                finite(|| format!("{name}.yaw"), b.yaw)?;
+                for (k, h) in b.half_extents.iter().enumerate() {
+                    if !(h.is_finite() && *h >= 0.0) {
+                        return Err(ReportError::OutOfRange {
+                            field: format!("{name}.half_extents[{k}]"),
+                            value: *h,
+                            allowed: "a finite length ≥ 0 m",
+                        });
+                    }
+                }
+            }
+            if let Some(z) = cell.floor_z {
+                finite(|| "cell.floor_z".into(), z)?;
+            }
+        }
+        let state_ref = |field: String, s: usize| {
+            if s < self.states.len() {
+                Ok(())
+            } else {
+                Err(ReportError::OutOfRange {
+                    field,
+                    value: s as f64,
+                    allowed: "an index into states",
+                })
+            }
+        };
+        for (mi, m) in self.modes.iter().enumerate() {
+            state_ref(format!("modes[{mi}].state"), m.state)?;
+            finite(|| format!("modes[{mi}].blf"), m.blf)?;
+            let printed = self.states.get(m.state).map_or(0, |s| s.layers_printed);
+            let expected = self.printed_nodes(printed);
+            if m.displacement.len() != expected {
+                return Err(mismatch(
+                    format!("modes[{mi}].displacement"),
+                    m.displacement.len(),
+                    expected,
+                ));
+            }
+            for (k, d) in m.displacement.iter().enumerate() {
+                finite3(|| format!("modes[{mi}].displacement[{k}]"), d)?;
+            }
+        }
+        for (wi, w) in self.worst_places.iter().enumerate() {
+            if let Some(s) = w.state {
+                state_ref(format!("worst_places[{wi}].state"), s)?;
+            }
+            finite3(|| format!("worst_places[{wi}].position"), &w.position)?;
+            if let Some(v) = w.signed_value {
+                finite(|| format!("worst_places[{wi}].signed_value"), v)?;
+            }
+        }
+        for (qi, q) in self.quantities.iter().enumerate() {
+            if !(q.to_unit.is_finite() && q.to_unit != 0.0) {
+                return Err(ReportError::OutOfRange {
+                    field: format!("quantities[{qi}].to_unit"),
+                    value: q.to_unit,
+                    allowed: "a finite, non-zero factor",
+                });
+            }
+            let one = q.states.len() == 1;
+            if !one && q.states.len() != self.states.len() {
+                return Err(mismatch(
+                    format!("quantities[{qi}].states"),
+                    q.states.len(),
+                    self.states.len(),
+                ));
+            }
+            for (si, values) in q.states.iter().enumerate() {
+                let printed = if one {
+                    self.layers.len()
+                } else {
+                    self.states.get(si).map_or(0, |s| s.layers_printed)
+                };
+                let expected = match q.per {
+                    QuantityPer::Layer => printed,
+                    QuantityPer::Segment => self.printed_segments(printed),
+                };
+                if values.len() != expected {
+                    return Err(mismatch(
+                        format!("quantities[{qi}].states[{si}]"),
+                        values.len(),
+                        expected,
+                    ));
+                }
+                for (k, v) in values.iter().enumerate() {
+                    finite(|| format!("quantities[{qi}].states[{si}][{k}]"), *v)?;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 impl RobotAnimation {
-    fn validate(&self) -> Result<(), ReportError> {
+    fn validate(&self, cell: Option<&Cell>) -> Result<(), ReportError> {
         let n = self.times.len();
         if self.joints.len() != n {
             return Err(mismatch("robot.joints".into(), self.joints.len(), n));
         }
-        if self.poses.len() != n {
+        let meshes = cell.is_some_and(|c| !c.stations.is_empty());
+        if self.poses.len() != n && !(meshes && self.poses.is_empty()) {
             return Err(mismatch("robot.poses".into(), self.poses.len(), n));
+        }
+        if !self.station.is_empty() {
+            if self.station.len() != n {
+                return Err(mismatch("robot.station".into(), self.station.len(), n));
+            }
+            let stations = cell.map_or(0, |c| c.stations.len());
+            if let Some((i, &s)) = self
+                .station
+                .iter()
+                .enumerate()
+                .find(|(_, s)| **s >= stations)
+            {
+                return Err(ReportError::OutOfRange {
+                    field: format!("robot.station[{i}]"),
+                    value: s as f64,
+                    allowed: "an index into cell.stations",
+                });
+            }
         }
         let mut last = f64::NEG_INFINITY;
         for (i, &t) in self.times.iter().enumerate() {

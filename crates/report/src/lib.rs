@@ -49,8 +49,9 @@ pub use html::{
     escape_inline_script, render_html, scene_json,
 };
 pub use input::{
-    BedJoint, Bound, ConstraintRow, Layer, Parameter, Plot, PrintPath, PrintState, ReportInput,
-    RobotAnimation, Series, Vec3,
+    BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, Plot,
+    PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Series, Station,
+    Timeline, Vec3, WorstPlace,
 };
 pub use plots::{PLOT_SIZE, PlotSpec, ReferenceLine, fmt_num, render_svg, standard_plots};
 pub use study::{StudyCell, StudyColumn, StudyRow, StudyTable, render_study_html};
