@@ -123,3 +123,38 @@ pub fn ss_plate(n: usize) -> ShellModel {
     }
     m
 }
+
+/// [`ss_plate`] with thickness `thickness` and **hard** simple supports for a
+/// Reissner–Mindlin plate: on x = 0, a also θx (the rotation whose Kirchhoff value is ∂w/∂y,
+/// the tangential slope of the edge) is fixed, on y = 0, a also θy. This is the support of
+/// the Navier (double-sine) solution of the Mindlin plate; with the rotations free ("soft"
+/// support) a shear-deformable plate has an edge boundary layer and buckles lower.
+/// For a Kirchhoff element both give the same limit.
+pub fn ss_plate_hard(n: usize, thickness: f64) -> ShellModel {
+    let mut m = ss_plate(n);
+    m.thickness = vec![thickness];
+    let mut fixed = vec![[false; 6]; m.nodes.len()];
+    for s in &m.supports {
+        if let Some(f) = fixed.get_mut(s.node) {
+            *f = s.fixed;
+        }
+    }
+    for j in 0..=n {
+        for i in 0..=n {
+            let f = &mut fixed[id(n, i, j)];
+            if i == 0 || i == n {
+                f[3] = true;
+            }
+            if j == 0 || j == n {
+                f[4] = true;
+            }
+        }
+    }
+    m.supports = fixed
+        .into_iter()
+        .enumerate()
+        .filter(|(_, f)| f.iter().any(|b| *b))
+        .map(|(node, fixed)| Support { node, fixed })
+        .collect();
+    m
+}

@@ -264,7 +264,9 @@ pub fn parse_mesh(text: &str) -> Result<ShellModel, FeError> {
         model.element = a.as_str().and_then(ElementKind::from_name).ok_or_else(|| {
             fmt_err(
                 "element",
-                format!("unknown element {a}; allowed: \"cst_dkt\", \"andes_dkt\""),
+                format!(
+                    "unknown element {a}; allowed: \"cst_dkt\", \"andes_dkt\", \"andes_dkmt\", \"cst_dkmt\""
+                ),
             )
         })?;
     }

@@ -101,15 +101,23 @@ pub enum ElementKind {
     /// ANDES/OPT membrane with drilling freedoms + DKT plate
     /// ([`crate::element::andes_dkt::AndesDkt`]); `drilling_alpha` is not used.
     AndesDkt,
+    /// ANDES/OPT membrane + DKMT Reissner–Mindlin plate (transverse shear, κ = 5/6;
+    /// [`crate::element::dkmt::AndesDkmt`]); `drilling_alpha` is not used.
+    AndesDkmt,
+    /// CST membrane + drilling spring + DKMT Reissner–Mindlin plate
+    /// ([`crate::element::dkmt::CstDkmt`]).
+    CstDkmt,
 }
 
 impl ElementKind {
     /// Parse the names used in mesh JSON and on the command line: `cst_dkt` / `cst`,
-    /// `andes_dkt` / `andes`.
+    /// `andes_dkt` / `andes`, `andes_dkmt` / `dkmt` / `mindlin`, `cst_dkmt`.
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "cst_dkt" | "cst" => Some(Self::CstDkt),
             "andes_dkt" | "andes" => Some(Self::AndesDkt),
+            "andes_dkmt" | "dkmt" | "mindlin" => Some(Self::AndesDkmt),
+            "cst_dkmt" => Some(Self::CstDkmt),
             _ => None,
         }
     }
@@ -119,6 +127,8 @@ impl ElementKind {
         match self {
             Self::CstDkt => "cst_dkt",
             Self::AndesDkt => "andes_dkt",
+            Self::AndesDkmt => "andes_dkmt",
+            Self::CstDkmt => "cst_dkmt",
         }
     }
 
@@ -127,6 +137,10 @@ impl ElementKind {
         match self {
             Self::CstDkt => "CST + DKT + drilling (alpha = model drilling_alpha)",
             Self::AndesDkt => "ANDES/OPT membrane with drilling freedoms + DKT (Felippa 2003)",
+            Self::AndesDkmt => {
+                "ANDES/OPT membrane + DKMT Reissner-Mindlin plate, shear factor 5/6 (Katili 1993)"
+            }
+            Self::CstDkmt => "CST + drilling + DKMT Reissner-Mindlin plate, shear factor 5/6",
         }
     }
 
@@ -135,6 +149,8 @@ impl ElementKind {
         match self {
             Self::CstDkt => Box::new(crate::element::cst_dkt::CstDkt),
             Self::AndesDkt => Box::new(crate::element::andes_dkt::AndesDkt),
+            Self::AndesDkmt => Box::new(crate::element::dkmt::AndesDkmt),
+            Self::CstDkmt => Box::new(crate::element::dkmt::CstDkmt),
         }
     }
 }

@@ -504,7 +504,12 @@ impl BucklingSolver {
         let el = &*self.element;
         let elements = &static_result.elements;
         let kg = assemble(model, &self.dofs, &self.pattern, |e| {
-            el.geometric_stiffness(&geo[e], &elements[e].resultants.membrane)
+            el.geometric_stiffness(
+                &geo[e],
+                model.thickness_of(e),
+                &model.material_of(e),
+                &elements[e].resultants.membrane,
+            )
         })?;
         drop(geo);
         stats.t_geometric += t0.elapsed().as_secs_f64();
@@ -639,7 +644,12 @@ impl BucklingSolver {
         let st = self.static_internal(model, &mut stats)?;
         let el = &*self.element;
         let kg = assemble(model, &self.dofs, &self.pattern, |e| {
-            el.geometric_stiffness(&st.geo[e], &st.result.elements[e].resultants.membrane)
+            el.geometric_stiffness(
+                &st.geo[e],
+                model.thickness_of(e),
+                &model.material_of(e),
+                &st.result.elements[e].resultants.membrane,
+            )
         })?;
         Ok(self.sturm_count(&st.kvals, &kg, sigma)?.1)
     }
@@ -655,7 +665,12 @@ impl BucklingSolver {
         let st = self.static_internal(model, &mut stats)?;
         let el = &*self.element;
         let kg = assemble(model, &self.dofs, &self.pattern, |e| {
-            el.geometric_stiffness(&st.geo[e], &st.result.elements[e].resultants.membrane)
+            el.geometric_stiffness(
+                &st.geo[e],
+                model.thickness_of(e),
+                &model.material_of(e),
+                &st.result.elements[e].resultants.membrane,
+            )
         })?;
         let n = self.pattern.n;
         let mut kd = vec![0.0; n * n];

@@ -186,8 +186,8 @@ impl AndesDkt {
         kb + higher_order(g, t, &c, opt_beta0(m.poisson_ratio))
     }
 
-    /// Local (element-frame) elastic stiffness, 18×18, node-major (u, v, w, θx, θy, θz).
-    pub fn local_stiffness(g: &TriangleGeometry, t: f64, m: &Material) -> Mat18 {
+    /// Local 18×18 matrix with only the ANDES membrane block (u, v, θz) filled.
+    pub(crate) fn local_membrane(g: &TriangleGeometry, t: f64, m: &Material) -> Mat18 {
         let km = Self::membrane_stiffness(g, t, m);
         let mut k = Mat18::zeros();
         for (i, &gi) in MEMB.iter().enumerate() {
@@ -195,8 +195,25 @@ impl AndesDkt {
                 k[(gi, gj)] = km[(i, j)];
             }
         }
+        k
+    }
+
+    /// Local (element-frame) elastic stiffness, 18×18, node-major (u, v, w, θx, θy, θz).
+    pub fn local_stiffness(g: &TriangleGeometry, t: f64, m: &Material) -> Mat18 {
+        let mut k = Self::local_membrane(g, t, m);
         add_dkt_bending(&mut k, g, t, m);
         k
+    }
+
+    /// Membrane forces `N = t C ε̄` from the mean strain (= the centroid strain).
+    pub(crate) fn membrane_forces(
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        ul: &[f64; 18],
+    ) -> [f64; 3] {
+        let n = plane_stress(m.poisson_ratio, m.youngs_modulus * t) * Self::mean_strain(g, ul);
+        [n[0], n[1], n[2]]
     }
 
     /// Mean membrane strain `ε̄ = Lᵀ u_m / V` = `[ε_x, ε_y, γ_xy]` from local displacements.
@@ -218,14 +235,19 @@ impl ShellElement for AndesDkt {
     /// centroid: the OPT higher-order strain vanishes there); DKT moments at the centroid.
     fn resultants(&self, g: &TriangleGeometry, t: f64, m: &Material, u: &[f64; 18]) -> Resultants {
         let ul = to_local(u, &g.frame);
-        let n = plane_stress(m.poisson_ratio, m.youngs_modulus * t) * Self::mean_strain(g, &ul);
         Resultants {
-            membrane: [n[0], n[1], n[2]],
+            membrane: Self::membrane_forces(g, t, m, &ul),
             moment: dkt_centroid_moment(g, t, m, &ul),
         }
     }
 
-    fn geometric_stiffness(&self, g: &TriangleGeometry, n: &[f64; 3]) -> Mat18 {
+    fn geometric_stiffness(
+        &self,
+        g: &TriangleGeometry,
+        _t: f64,
+        _m: &Material,
+        n: &[f64; 3],
+    ) -> Mat18 {
         to_global(&CstDkt::local_geometric_stiffness(g, n), &g.frame)
     }
 }

@@ -221,10 +221,10 @@ impl Dkt {
 }
 
 /// Mid-side points (exact for the quadratic integrand `B_bᵀ D_b B_b`, B_b linear).
-const MIDSIDE: [(f64, f64); 3] = [(0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
+pub(crate) const MIDSIDE: [(f64, f64); 3] = [(0.5, 0.0), (0.5, 0.5), (0.0, 0.5)];
 
 /// Strang–Fix/Dunavant 6-point rule, degree 4 (weights sum to 1, multiply by A).
-const GAUSS6: [(f64, f64, f64); 6] = [
+pub(crate) const GAUSS6: [(f64, f64, f64); 6] = [
     (
         0.445_948_490_915_965,
         0.445_948_490_915_965,
@@ -287,36 +287,55 @@ pub(crate) fn dkt_centroid_moment(
     [mm[0], mm[1], mm[2]]
 }
 
-impl CstDkt {
-    /// Local (element-frame) elastic stiffness, 18×18, node-major (u, v, w, θx, θy, θz).
-    pub fn local_stiffness(g: &TriangleGeometry, t: f64, m: &Material, alpha: f64) -> Mat18 {
-        let e = m.youngs_modulus;
-        let nu = m.poisson_ratio;
-        let mut k = Mat18::zeros();
-        // Membrane.
-        let bm = b_membrane(g);
-        let km = bm.transpose() * plane_stress(nu, e * t) * bm * g.area;
-        for i in 0..3 {
-            for j in 0..3 {
-                for a in 0..2 {
-                    for b in 0..2 {
-                        k[(6 * i + a, 6 * j + b)] += km[(2 * i + a, 2 * j + b)];
-                    }
+/// Add the CST membrane and the drilling spring `α E t A` to a local 18×18 matrix.
+pub(crate) fn add_cst_membrane(
+    k: &mut Mat18,
+    g: &TriangleGeometry,
+    t: f64,
+    m: &Material,
+    alpha: f64,
+) {
+    let e = m.youngs_modulus;
+    let bm = b_membrane(g);
+    let km = bm.transpose() * plane_stress(m.poisson_ratio, e * t) * bm * g.area;
+    for i in 0..3 {
+        for j in 0..3 {
+            for a in 0..2 {
+                for b in 0..2 {
+                    k[(6 * i + a, 6 * j + b)] += km[(2 * i + a, 2 * j + b)];
                 }
             }
         }
-        // Bending.
+    }
+    let kd = alpha * e * t * g.area;
+    for n in 0..3 {
+        k[(6 * n + 5, 6 * n + 5)] += kd;
+    }
+}
+
+impl CstDkt {
+    /// Local (element-frame) elastic stiffness, 18×18, node-major (u, v, w, θx, θy, θz).
+    pub fn local_stiffness(g: &TriangleGeometry, t: f64, m: &Material, alpha: f64) -> Mat18 {
+        let mut k = Mat18::zeros();
+        add_cst_membrane(&mut k, g, t, m, alpha);
         add_dkt_bending(&mut k, g, t, m);
-        // Drilling spring.
-        let kd = alpha * e * t * g.area;
-        for n in 0..3 {
-            k[(6 * n + 5, 6 * n + 5)] += kd;
-        }
         k
     }
 
-    /// Local geometric stiffness for membrane forces `n = [N_x, N_y, N_xy]`.
-    pub fn local_geometric_stiffness(g: &TriangleGeometry, n: &[f64; 3]) -> Mat18 {
+    /// CST membrane forces `N = D_m B_m u_m` from the 18 local displacements.
+    pub(crate) fn membrane_forces(
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        ul: &[f64; 18],
+    ) -> [f64; 3] {
+        let um = SMatrix::<f64, 6, 1>::from([ul[0], ul[1], ul[6], ul[7], ul[12], ul[13]]);
+        let nm = plane_stress(m.poisson_ratio, m.youngs_modulus * t) * b_membrane(g) * um;
+        [nm[0], nm[1], nm[2]]
+    }
+
+    /// In-plane part of the geometric stiffness (`u`, `v` rows only, linear shape functions).
+    pub(crate) fn local_geometric_stiffness_in_plane(g: &TriangleGeometry, n: &[f64; 3]) -> Mat18 {
         let nh = nalgebra::Matrix2::new(n[0], n[2], n[2], n[1]);
         let (b, c) = linear_gradients(g);
         let gm = SMatrix::<f64, 2, 3>::new(b[0], b[1], b[2], c[0], c[1], c[2]);
@@ -328,6 +347,13 @@ impl CstDkt {
                 k[(6 * i + 1, 6 * j + 1)] += kuu[(i, j)];
             }
         }
+        k
+    }
+
+    /// Local geometric stiffness for membrane forces `n = [N_x, N_y, N_xy]`.
+    pub fn local_geometric_stiffness(g: &TriangleGeometry, n: &[f64; 3]) -> Mat18 {
+        let nh = nalgebra::Matrix2::new(n[0], n[2], n[2], n[1]);
+        let mut k = Self::local_geometric_stiffness_in_plane(g, n);
         let dkt = Dkt::new(g);
         let mut kw = Mat9::zeros();
         for &(xi, eta, w) in &GAUSS6 {
@@ -355,15 +381,19 @@ impl ShellElement for CstDkt {
 
     fn resultants(&self, g: &TriangleGeometry, t: f64, m: &Material, u: &[f64; 18]) -> Resultants {
         let ul = to_local(u, &g.frame);
-        let um = SMatrix::<f64, 6, 1>::from([ul[0], ul[1], ul[6], ul[7], ul[12], ul[13]]);
-        let nm = plane_stress(m.poisson_ratio, m.youngs_modulus * t) * b_membrane(g) * um;
         Resultants {
-            membrane: [nm[0], nm[1], nm[2]],
+            membrane: Self::membrane_forces(g, t, m, &ul),
             moment: dkt_centroid_moment(g, t, m, &ul),
         }
     }
 
-    fn geometric_stiffness(&self, g: &TriangleGeometry, n: &[f64; 3]) -> Mat18 {
+    fn geometric_stiffness(
+        &self,
+        g: &TriangleGeometry,
+        _t: f64,
+        _m: &Material,
+        n: &[f64; 3],
+    ) -> Mat18 {
         to_global(&Self::local_geometric_stiffness(g, n), &g.frame)
     }
 }

@@ -7,6 +7,7 @@
 
 pub mod andes_dkt;
 pub mod cst_dkt;
+pub mod dkmt;
 
 use nalgebra::SMatrix;
 
@@ -80,8 +81,16 @@ pub trait ShellElement: Send + Sync {
     /// Resultants from the element's 18 global displacements.
     fn resultants(&self, g: &TriangleGeometry, t: f64, m: &Material, u: &[f64; 18]) -> Resultants;
     /// Global geometric stiffness for constant membrane forces `n = [N_x, N_y, N_xy]`
-    /// (tension positive), so that `(K + λ K_G) φ = 0` is the buckling pencil.
-    fn geometric_stiffness(&self, g: &TriangleGeometry, n: &[f64; 3]) -> Mat18;
+    /// (tension positive), so that `(K + λ K_G) φ = 0` is the buckling pencil. Thickness and
+    /// material are passed because a shear-deformable plate's deflection slopes depend on
+    /// them (`∇w = γ − β`, see [`dkmt`]); Kirchhoff elements ignore them.
+    fn geometric_stiffness(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        n: &[f64; 3],
+    ) -> Mat18;
 }
 
 /// Rotate a local 18×18 matrix to the global frame: `Tᵀ K T`, T = blockdiag(R ×6).

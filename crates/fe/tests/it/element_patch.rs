@@ -5,6 +5,7 @@
 
 use kappe_fe::element::andes_dkt::AndesDkt;
 use kappe_fe::element::cst_dkt::CstDkt;
+use kappe_fe::element::dkmt::AndesDkmt;
 use kappe_fe::element::{ShellElement, TriangleGeometry};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -289,8 +290,8 @@ fn a10_element_orientation_independent() {
             "K",
         ),
         (
-            CstDkt.geometric_stiffness(&g1, &nf),
-            CstDkt.geometric_stiffness(&g2, &nf2),
+            CstDkt.geometric_stiffness(&g1, 0.02, &mat, &nf),
+            CstDkt.geometric_stiffness(&g2, 0.02, &mat, &nf2),
             "K_G",
         ),
         (
@@ -299,9 +300,19 @@ fn a10_element_orientation_independent() {
             "ANDES K",
         ),
         (
-            AndesDkt.geometric_stiffness(&g1, &nf),
-            AndesDkt.geometric_stiffness(&g2, &nf2),
+            AndesDkt.geometric_stiffness(&g1, 0.02, &mat, &nf),
+            AndesDkt.geometric_stiffness(&g2, 0.02, &mat, &nf2),
             "ANDES K_G",
+        ),
+        (
+            AndesDkmt.stiffness(&g1, 0.02, &mat, 1e-3),
+            AndesDkmt.stiffness(&g2, 0.02, &mat, 1e-3),
+            "ANDES+DKMT K",
+        ),
+        (
+            AndesDkmt.geometric_stiffness(&g1, 0.02, &mat, &nf),
+            AndesDkmt.geometric_stiffness(&g2, 0.02, &mat, &nf2),
+            "ANDES+DKMT K_G",
         ),
     ] {
         let scale = k1.abs().max();

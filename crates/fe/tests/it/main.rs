@@ -10,4 +10,5 @@ mod closed_form;
 mod common;
 mod element_patch;
 mod fixtures;
+mod mindlin;
 mod solver_checks;
