@@ -7,8 +7,10 @@ use parry3d_f64::glamx::DVec3;
 use serde::Serialize;
 
 use crate::frames::{Iso, angle_between};
-use crate::kinematics::{JOINT_LIMITS, MAX_JOINT_SPEED, UR10E, within_limits};
+use crate::kinematics::{JOINT_LIMITS, UR10E, within_limits};
+use crate::plan::Station;
 use crate::plan::{CLEARANCE_CUTOFF, Plan, transition_collision, validate};
+use crate::setup::PlanOptions;
 use crate::setup::{PathPoint, PrintLayer};
 
 /// Tolerance of the TCP position (m) and tool axis (rad) on the targets (acceptance: 1e-6).
@@ -22,7 +24,9 @@ pub struct CheckReport {
     pub max_axis_error: f64,
     pub min_clearance: f64,
     pub min_self_distance: f64,
+    /// Largest |q̇_j| / (s·v_j,max) and |q̈_j| / a_j,max over the rows of the trajectory.
     pub max_speed_ratio: f64,
+    pub max_acceleration_ratio: f64,
     pub problems: Vec<String>,
 }
 
@@ -101,7 +105,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 problems.push(format!("move into layer {}: {msg}", l.layer));
             }
             let mut branch = None;
-            for (k, w) in l.waypoints.iter().enumerate() {
+            for w in &l.waypoints {
                 rep.waypoints += 1;
                 let at = || format!("station {si} layer {} point {}", l.layer, w.index);
                 let q = w.q;
@@ -166,34 +170,16 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                         opts.clearance
                     ));
                 }
-                if k > 0 {
-                    let p = &l.waypoints[k - 1];
-                    let dt = w.t - p.t;
-                    for j in 0..6 {
-                        let dq = (w.q[j] - p.q[j]).abs();
-                        let ratio = if dt > 0.0 {
-                            dq / dt / MAX_JOINT_SPEED[j]
-                        } else if dq > 0.0 {
-                            f64::INFINITY
-                        } else {
-                            0.0
-                        };
-                        rep.max_speed_ratio = rep.max_speed_ratio.max(ratio);
-                        // 1e-9: relative slack for the division.
-                        if ratio > opts.speed_fraction * (1.0 + 1e-9) {
-                            problems.push(format!(
-                                "{}: joint {} at {:.3} of its speed limit",
-                                at(),
-                                j + 1,
-                                ratio
-                            ));
-                        }
-                    }
+                if !(w.hold.is_finite() && w.hold >= 0.0) {
+                    problems.push(format!("{}: hold {} s is not ≥ 0", at(), w.hold));
                 }
             }
             prev_end = l.waypoints.last().map(|w| w.q);
             order += 1;
         }
+        let (ratio_v, ratio_a) = check_rates(si, st, opts, &mut problems);
+        rep.max_speed_ratio = rep.max_speed_ratio.max(ratio_v);
+        rep.max_acceleration_ratio = rep.max_acceleration_ratio.max(ratio_a);
     }
     let n = problems.len();
     if n > 20 {
@@ -202,4 +188,86 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
     }
     rep.problems = problems;
     rep
+}
+
+/// Joint speeds and accelerations of one station from its rows alone (arrival and, where the
+/// robot holds, departure of every waypoint; at rest before the first and after the last):
+/// v = Δq/Δt per segment, a = Δv/τ with τ the mean of the two segment durations.
+/// Returns the largest speed ratio (to s·v_max) and acceleration ratio (to a_max).
+fn check_rates(
+    si: usize,
+    st: &Station,
+    opts: &PlanOptions,
+    problems: &mut Vec<String>,
+) -> (f64, f64) {
+    let vmax = opts.limits.max_speed();
+    let amax = opts.limits.max_acceleration;
+    // Rows: (time, q, label).
+    let mut rows: Vec<(f64, [f64; 6], (i64, usize))> = Vec::new();
+    for l in &st.layers {
+        for w in &l.waypoints {
+            rows.push((w.t, w.q, (l.layer, w.index)));
+            if w.hold > 0.0 {
+                rows.push((w.t + w.hold, w.q, (l.layer, w.index)));
+            }
+        }
+    }
+    // Segment velocities, with zero-length rests at both ends.
+    let mut segs: Vec<(f64, [f64; 6])> = vec![(0.0, [0.0; 6])];
+    let (mut rv, mut ra) = (0.0f64, 0.0f64);
+    for k in 1..rows.len() {
+        let (t0, q0, _) = rows[k - 1];
+        let (t1, q1, at) = rows[k];
+        let dt = t1 - t0;
+        let moved = (0..6).any(|j| q1[j] != q0[j]);
+        if dt <= 0.0 && moved {
+            problems.push(format!(
+                "station {si} layer {} point {}: moves in {dt} s",
+                at.0, at.1
+            ));
+            continue;
+        }
+        let v: [f64; 6] =
+            std::array::from_fn(|j| if dt > 0.0 { (q1[j] - q0[j]) / dt } else { 0.0 });
+        for j in 0..6 {
+            let r = v[j].abs() / (opts.speed_fraction * vmax[j]);
+            rv = rv.max(r);
+            // 1e-9: relative slack for the division.
+            if r > 1.0 + 1e-9 {
+                problems.push(format!(
+                    "station {si} layer {} point {}: joint {} at {:.3} of its usable speed",
+                    at.0,
+                    at.1,
+                    j + 1,
+                    r
+                ));
+            }
+        }
+        segs.push((dt.max(0.0), v));
+    }
+    segs.push((0.0, [0.0; 6]));
+    for k in 0..segs.len().saturating_sub(1) {
+        let tau = 0.5 * (segs[k].0 + segs[k + 1].0);
+        if tau <= 0.0 {
+            continue;
+        }
+        for j in 0..6 {
+            let r = (segs[k + 1].1[j] - segs[k].1[j]).abs() / tau / amax[j];
+            ra = ra.max(r);
+            // 1e-6: the timing leaves ≥ 1e-9 relative margin; the rows' f64 round-off is far below.
+            if r > 1.0 + 1e-6 {
+                let at = rows
+                    .get(k.min(rows.len().saturating_sub(1)))
+                    .map_or((0, 0), |r| r.2);
+                problems.push(format!(
+                    "station {si} near layer {} point {}: joint {} accelerates at {:.3} of its limit",
+                    at.0,
+                    at.1,
+                    j + 1,
+                    r
+                ));
+            }
+        }
+    }
+    (rv, ra)
 }

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::collision::{CapsuleSpec, LINK_NAMES, Obstacle, RobotModel, Scene, TOOL_LINK};
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, Mat4, frame_from_z};
-use crate::kinematics::{JOINT_LIMITS, Joints, MAX_JOINT_SPEED, UR10E, joint_delta, within_limits};
+use crate::kinematics::{JOINT_LIMITS, Joints, UR10E, joint_delta, within_limits};
 use crate::ladder::{LadderFailure, solve_optimal, solve_random};
 use crate::setup::{BasePlacement, PlanOptions, PlannerKind, PrintLayer, RobotSetup};
 
@@ -34,6 +34,14 @@ pub struct Waypoint {
     /// Target nozzle-tip position and tool axis (world), kept for re-verification.
     pub position: [f64; 3],
     pub axis: [f64; 3],
+    /// Planned tool speed (m/s) of the move arriving here (0 at a station's first waypoint);
+    /// the flow follows it.
+    #[serde(default)]
+    pub speed: f64,
+    /// Time (s) the robot stays here after arriving: priming at a station's first waypoint, a
+    /// pause (wait, program change, re-priming) at a layer's last.
+    #[serde(default)]
+    pub hold: f64,
 }
 
 /// One planned layer.
@@ -47,6 +55,9 @@ pub struct LayerPlan {
     pub min_clearance: f64,
     /// Largest |q̇_j|/v_j,max along the layer.
     pub max_speed_ratio: f64,
+    /// Scheduled wait after the layer (s): from the schedule, or the minimum layer time.
+    #[serde(default)]
+    pub wait: f64,
 }
 
 /// All layers printed from one base pose.
@@ -77,6 +88,15 @@ pub struct Plan {
     pub min_self_distance: f64,
     /// Largest |q̇_j|/v_j,max while printing.
     pub max_speed_ratio: f64,
+    /// Largest |q̈_j|/a_j,max over the rows of the trajectory.
+    #[serde(default)]
+    pub max_acceleration_ratio: f64,
+    /// Where the tool is slower than the design speed (the flow follows it).
+    #[serde(default)]
+    pub slowdowns: Vec<crate::timing::Slowdown>,
+    /// The program files, in order.
+    #[serde(default)]
+    pub parts: Vec<crate::program::ProgramPart>,
     /// The setup (with the base placement resolved to the stations) and options used.
     pub setup: RobotSetup,
     pub options: PlanOptions,
@@ -183,6 +203,54 @@ pub(crate) fn validate(
             ),
         ));
     }
+    let pr = &opts.program;
+    if pr.max_moves_per_program < 4 {
+        return Err(RobotError::invalid(
+            "program.max_moves_per_program",
+            format!(
+                "{}: a program needs at least 4 targets (approach, descent, a print move, retract)",
+                pr.max_moves_per_program
+            ),
+        ));
+    }
+    pos("program.approach_distance (m)", pr.approach_distance)?;
+    pos("program.approach_speed (m/s)", pr.approach_speed)?;
+    pos("program.tool_acceleration (m/s²)", pr.tool_acceleration)?;
+    pos("program.joint_speed (rad/s)", pr.joint_speed)?;
+    pos("program.joint_acceleration (rad/s²)", pr.joint_acceleration)?;
+    for (name, v) in [
+        ("program.blend_radius (m)", pr.blend_radius),
+        ("program.program_switch_time (s)", pr.program_switch_time),
+        ("program.payload_mass (kg)", pr.payload_mass),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(RobotError::invalid(
+                name,
+                format!("{v}: must be finite and ≥ 0"),
+            ));
+        }
+    }
+    if !pr.payload_cog.iter().all(|v| v.is_finite()) {
+        return Err(RobotError::invalid(
+            "program.payload_cog (m)",
+            format!("{:?}: must be finite", pr.payload_cog),
+        ));
+    }
+    for j in 0..6 {
+        let (v, a) = (
+            opts.limits.max_speed_deg_s[j],
+            opts.limits.max_acceleration[j],
+        );
+        if !(v.is_finite() && v > 0.0 && a.is_finite() && a > 0.0) {
+            return Err(RobotError::invalid(
+                format!("limits (joint {})", j + 1),
+                format!("speed {v} °/s, acceleration {a} rad/s²: must be finite and > 0"),
+            ));
+        }
+    }
+    // Flow at the design speed: Q = lw·lh·v with lw = 2·bead_radius, lh = 2·bead_offset.
+    opts.pump
+        .validate(4.0 * opts.bead_radius * opts.bead_offset.abs() * opts.print_speed)?;
     if opts.rotation_steps == 0 || opts.rotation_steps > 360 {
         return Err(RobotError::invalid(
             "rotation_steps",
@@ -563,20 +631,17 @@ pub(crate) fn plan_station(
         .collect();
     let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
-    // Allowed joint step per rung boundary (None at a layer change).
-    let steps: Vec<Option<[f64; 6]>> = (0..rung_ids.len().saturating_sub(1))
+    // Allowed joint step per rung boundary. The layer change is a printed move like any other
+    // (continuous extrusion), so the same speed, ε and branch rules hold across it.
+    let vmax = ctx.opts.limits.max_speed();
+    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
         .map(|r| {
             let (o0, k0) = rung_ids[r];
             let (o1, k1) = rung_ids[r + 1];
-            if o0 != o1 {
-                return None;
-            }
             let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
             let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
             let dt = (p1 - p0).length() / ctx.opts.print_speed;
-            Some(std::array::from_fn(|j| {
-                ctx.opts.speed_fraction * MAX_JOINT_SPEED[j] * dt
-            }))
+            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
         })
         .collect();
     let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
@@ -587,27 +652,16 @@ pub(crate) fn plan_station(
     let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
         let a = &built[r].0[i].q;
         let b = &built[r + 1].0[j].q;
-        match &steps[r] {
-            Some(lim) => {
-                if branch(a) != branch(b) {
-                    return None;
-                }
-                let d = joint_delta(a, b);
-                if (0..n_cost).any(|j| d[j].abs() > lim[j]) {
-                    return None;
-                }
-                let c = step_cost(a, b);
-                (c <= ctx.opts.epsilon).then_some(c)
-            }
-            None => {
-                let pen = if branch(a) != branch(b) {
-                    ctx.opts.reconfiguration_penalty
-                } else {
-                    0.0
-                };
-                Some(step_cost(a, b) + pen)
-            }
+        let lim = &steps[r];
+        if branch(a) != branch(b) {
+            return None;
         }
+        let d = joint_delta(a, b);
+        if (0..n_cost).any(|j| d[j].abs() > lim[j]) {
+            return None;
+        }
+        let c = step_cost(a, b);
+        (c <= ctx.opts.epsilon).then_some(c)
     };
     let result = match ctx.opts.planner {
         PlannerKind::Optimal => solve_optimal(&sizes, edge),
@@ -709,9 +763,9 @@ pub(crate) fn plan_station(
             q[j] += s;
         }
     }
-    // Timing, layer summaries, transition checks.
+    // Layer summaries and collision checks of the joint-interpolated layer changes; the times
+    // come later from [`crate::timing`], once the whole plan is known.
     let mut layers_out = Vec::new();
-    let mut t = t0;
     let mut r = 0;
     let mut prev_q: Option<Joints> = None;
     for o in range.clone() {
@@ -726,31 +780,24 @@ pub(crate) fn plan_station(
                     msg,
                 ));
             }
-            t += transition_time(ctx, &pq, &q1);
         }
         let mut wps = Vec::with_capacity(layer.points.len());
-        let (mut cost, mut min_c, mut max_ratio) = (0.0, f64::INFINITY, 0.0f64);
+        let (mut cost, mut min_c) = (0.0, f64::INFINITY);
         for (k, p) in layer.points.iter().enumerate() {
             let q = unwrapped[r];
             if k > 0 {
-                let p0 = DVec3::from(layer.points[k - 1].position);
-                let dt = (DVec3::from(p.position) - p0).length() / ctx.opts.print_speed;
                 let dq: Vec<f64> = (0..6).map(|j| q[j] - unwrapped[r - 1][j]).collect();
                 cost += dq[..n_cost].iter().map(|v| v * v).sum::<f64>();
-                if dt > 0.0 {
-                    for j in 0..6 {
-                        max_ratio = max_ratio.max(dq[j].abs() / dt / MAX_JOINT_SPEED[j]);
-                    }
-                }
-                t += dt;
             }
             min_c = min_c.min(clear[r]);
             wps.push(Waypoint {
                 index: p.index,
-                t,
+                t: t0,
                 q,
                 position: p.position,
                 axis: p.axis,
+                speed: 0.0,
+                hold: 0.0,
             });
             r += 1;
         }
@@ -760,22 +807,14 @@ pub(crate) fn plan_station(
             waypoints: wps,
             cost,
             min_clearance: min_c,
-            max_speed_ratio: max_ratio,
+            max_speed_ratio: 0.0,
+            wait: 0.0,
         });
     }
     Ok(Station {
         world_from_base: world_from_base.to_mat4(),
         layers: layers_out,
     })
-}
-
-/// Duration (s) of the `movej` between layers at `transition_speed_fraction` of the limits.
-pub(crate) fn transition_time(ctx: &Context, a: &Joints, b: &Joints) -> f64 {
-    let mut t: f64 = 0.1;
-    for j in 0..6 {
-        t = t.max((b[j] - a[j]).abs() / (ctx.opts.transition_speed_fraction * MAX_JOINT_SPEED[j]));
-    }
-    t
 }
 
 /// Check the joint-interpolated move a → b at ≤ 1° steps; `order` is the layer about to start
@@ -818,12 +857,24 @@ pub(crate) fn transition_collision(
 }
 
 /// Plan the print: resolve the base placement (fixed, or searched with stations), plan every
-/// station, and summarise. The result still has to pass [`crate::check::check_plan`] before
-/// export; [`plan_print`] runs that check and fails if it does not pass.
+/// station, cut the programs, time everything ([`crate::timing`]; waits from the minimum layer
+/// time) and summarise. [`plan_print`] runs [`crate::check::check_plan`] on the result and fails
+/// if it does not pass.
 pub fn plan_print(
     layers: &[PrintLayer],
     setup: &RobotSetup,
     opts: &PlanOptions,
+) -> Result<Plan, RobotError> {
+    plan_print_with_waits(layers, setup, opts, None)
+}
+
+/// [`plan_print`] with per-layer waits (e.g. from the time-dependent schedule) instead of the
+/// minimum layer time.
+pub fn plan_print_with_waits(
+    layers: &[PrintLayer],
+    setup: &RobotSetup,
+    opts: &PlanOptions,
+    waits: Option<&[crate::timing::LayerWait]>,
 ) -> Result<Plan, RobotError> {
     let ctx = validate(layers, setup, opts)?;
     let stations = match &setup.base {
@@ -837,7 +888,9 @@ pub fn plan_print(
         }
         BasePlacement::Search(search) => crate::base::search_stations(&ctx, search)?,
     };
-    let plan = summarise(&ctx, stations);
+    let mut plan = summarise(&ctx, stations);
+    plan.parts = crate::program::split_parts(&plan)?;
+    crate::timing::apply_timing(&mut plan, waits)?;
     let report = crate::check::check_plan(&plan);
     if !report.problems.is_empty() {
         return Err(RobotError::Verification(report.problems));
@@ -848,23 +901,12 @@ pub fn plan_print(
 fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
     let mut cost = 0.0;
     let mut motion = 0.0;
-    let mut print_time = 0.0;
     let mut min_c = f64::INFINITY;
-    let mut max_ratio = 0.0f64;
-    let mut prev: Option<Joints>;
-    let mut first_t = None;
-    let mut last_t = 0.0;
     let mut min_self = f64::INFINITY;
     for s in &stations {
-        prev = None;
+        let mut prev: Option<Joints> = None;
         for l in &s.layers {
             min_c = min_c.min(l.min_clearance);
-            max_ratio = max_ratio.max(l.max_speed_ratio);
-            if let (Some(a), Some(b)) = (l.waypoints.first(), l.waypoints.last()) {
-                print_time += b.t - a.t;
-                first_t.get_or_insert(a.t);
-                last_t = b.t;
-            }
             for w in &l.waypoints {
                 if let Some(p) = prev {
                     for j in 0..6 {
@@ -891,11 +933,14 @@ fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
         flange_from_tcp: ctx.flange_from_tcp.to_mat4(),
         cost,
         joint_motion: motion,
-        print_time,
-        total_time: last_t - first_t.unwrap_or(0.0),
+        print_time: 0.0,
+        total_time: 0.0,
         min_clearance: min_c,
         min_self_distance: min_self,
-        max_speed_ratio: max_ratio,
+        max_speed_ratio: 0.0,
+        max_acceleration_ratio: 0.0,
+        slowdowns: Vec::new(),
+        parts: Vec::new(),
         setup,
         options: ctx.opts.clone(),
         stations,

@@ -224,12 +224,19 @@ pub struct PlanOptions {
     pub bead_radius: f64,
     /// Offset (m) from the nozzle tip to the bead centre line along the tool axis (lh/2).
     pub bead_offset: f64,
-    /// Fraction of the joint speed limits used by `movej` between layers.
+    /// Unused since the layer change is a printed move (kept so older files parse).
     pub transition_speed_fraction: f64,
-    /// Cost added when a layer change switches IK branch (shoulder/elbow/wrist).
+    /// Unused since the layer change is a printed move (kept so older files parse).
     pub reconfiguration_penalty: f64,
-    /// Time (s) allowed to move the mobile base between stations.
+    /// Time (s) allowed to move the mobile base between stations (and bring the arm to the
+    /// safe pose above the station's first target).
     pub station_change_time: f64,
+    /// Joint speed and acceleration limits used by the planner and the timing.
+    pub limits: JointLimitOptions,
+    /// The pump: flow output, calibration, priming, pauses.
+    pub pump: PumpOptions,
+    /// Per-layer waits (minimum layer time) when no schedule supplies them.
+    pub waits: WaitOptions,
     pub program: ProgramOptions,
 }
 
@@ -258,7 +265,241 @@ impl Default for PlanOptions {
             transition_speed_fraction: 0.25,
             reconfiguration_penalty: 10.0,
             station_change_time: 60.0,
+            limits: JointLimitOptions::default(),
+            pump: PumpOptions::default(),
+            waits: WaitOptions::default(),
             program: ProgramOptions::default(),
+        }
+    }
+}
+
+/// Joint speed and acceleration limits (UR10e defaults). Position limits are UR's (±360°, the
+/// elbow ±180°: [`crate::kinematics::JOINT_LIMITS`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct JointLimitOptions {
+    /// Maximum joint speeds (°/s): UR10e 120 for base and shoulder, 180 for elbow and wrists.
+    pub max_speed_deg_s: [f64; 6],
+    /// Maximum joint accelerations (rad/s²). UR publishes none (the arm is torque-limited);
+    /// 5 rad/s² is the conservative value of UR's own MoveIt configuration
+    /// (`ur_moveit_config/config/joint_limits.yaml`).
+    pub max_acceleration: [f64; 6],
+}
+
+impl Default for JointLimitOptions {
+    fn default() -> Self {
+        JointLimitOptions {
+            max_speed_deg_s: [120.0, 120.0, 180.0, 180.0, 180.0, 180.0],
+            max_acceleration: [5.0; 6],
+        }
+    }
+}
+
+impl JointLimitOptions {
+    /// Speed limits in rad/s.
+    pub fn max_speed(&self) -> [f64; 6] {
+        self.max_speed_deg_s.map(f64::to_radians)
+    }
+}
+
+/// Voltage or current range of a standard analog output (`set_analog_outputdomain`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AnalogDomain {
+    /// 4–20 mA (domain 0).
+    Current,
+    /// 0–10 V (domain 1).
+    #[default]
+    Voltage,
+}
+
+/// A digital output of the UR e-Series controller.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", content = "number", rename_all = "snake_case")]
+pub enum DigitalOutput {
+    /// `set_standard_digital_out(n, b)`, n = 0..=7.
+    Standard(u8),
+    /// `set_configurable_digital_out(n, b)`, n = 0..=7.
+    Configurable(u8),
+    /// `set_tool_digital_out(n, b)`, n = 0..=1.
+    Tool(u8),
+}
+
+impl DigitalOutput {
+    /// The URScript call that sets it.
+    pub fn call(&self, on: bool) -> String {
+        let b = if on { "True" } else { "False" };
+        match self {
+            DigitalOutput::Standard(n) => format!("set_standard_digital_out({n}, {b})"),
+            DigitalOutput::Configurable(n) => format!("set_configurable_digital_out({n}, {b})"),
+            DigitalOutput::Tool(n) => format!("set_tool_digital_out({n}, {b})"),
+        }
+    }
+
+    /// Highest output number the controller has for this kind.
+    pub fn max_number(&self) -> u8 {
+        match self {
+            DigitalOutput::Standard(_) | DigitalOutput::Configurable(_) => 7,
+            DigitalOutput::Tool(_) => 1,
+        }
+    }
+
+    fn number(&self) -> u8 {
+        match self {
+            DigitalOutput::Standard(n)
+            | DigitalOutput::Configurable(n)
+            | DigitalOutput::Tool(n) => *n,
+        }
+    }
+}
+
+/// What a pause (layer wait, program change) does with the pump.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PauseMode {
+    /// The pump stays enabled at the hold output (`hold_output`), so it does not have to be
+    /// primed again.
+    #[default]
+    KeepPrimed,
+    /// The pump is switched off and primed again (`prime_dwell`) before the print resumes.
+    Stop,
+}
+
+/// The earth pump: an analog flow set-point proportional to the volumetric flow lw·lh·v, an
+/// enable output, priming and pauses.
+///
+/// Output ratio (0..1 of the analog domain) = `flow_offset` + `flow_factor` · Q, with Q the
+/// volumetric flow in L/min (Q = lw·lh·v·60 000, lw = 2·bead_radius, lh = 2·bead_offset).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PumpOptions {
+    /// Standard analog output carrying the flow set-point (0 or 1).
+    pub flow_output: u8,
+    /// Its domain.
+    pub flow_domain: AnalogDomain,
+    /// Calibration factor: output ratio per L/min (> 0).
+    pub flow_factor: f64,
+    /// Calibration offset: output ratio at zero flow (the pump's dead band).
+    pub flow_offset: f64,
+    /// The pump's run/enable output; `None` if the flow set-point alone drives it.
+    pub enable_output: Option<DigitalOutput>,
+    /// Dwell (s) at a station's first target with the pump running before the bead starts.
+    pub prime_dwell: f64,
+    /// What a pause does with the pump.
+    pub pause: PauseMode,
+    /// Output ratio while paused with [`PauseMode::KeepPrimed`] (default: the offset, i.e. zero
+    /// flow with the pump enabled).
+    pub hold_output: Option<f64>,
+}
+
+impl Default for PumpOptions {
+    /// Flow on analog output 0 (0–10 V), 1.0 per L/min (the default bead, 20 × 8 mm at
+    /// 0.05 m/s, is 0.48 L/min → 0.48), no offset; enable on standard digital output 0; 2 s of
+    /// priming; pauses keep the pump primed.
+    fn default() -> Self {
+        PumpOptions {
+            flow_output: 0,
+            flow_domain: AnalogDomain::Voltage,
+            flow_factor: 1.0,
+            flow_offset: 0.0,
+            enable_output: Some(DigitalOutput::Standard(0)),
+            prime_dwell: 2.0,
+            pause: PauseMode::KeepPrimed,
+            hold_output: None,
+        }
+    }
+}
+
+impl PumpOptions {
+    /// The analog output ratio for volumetric flow `q_m3s` (m³/s).
+    pub fn output_for_flow(&self, q_m3s: f64) -> f64 {
+        self.flow_offset + self.flow_factor * q_m3s * 60_000.0
+    }
+
+    /// The output ratio while paused.
+    pub fn hold(&self) -> f64 {
+        self.hold_output.unwrap_or(self.flow_offset)
+    }
+
+    /// Check the outputs exist on the controller and the calibration is usable for flows up
+    /// to `max_flow_m3s`.
+    pub fn validate(&self, max_flow_m3s: f64) -> Result<(), crate::error::RobotError> {
+        use crate::error::RobotError;
+        if self.flow_output > 1 {
+            return Err(RobotError::invalid(
+                "pump.flow_output",
+                format!(
+                    "standard analog output {}: the UR e-Series controller has outputs 0 and 1",
+                    self.flow_output
+                ),
+            ));
+        }
+        if let Some(e) = self.enable_output
+            && e.number() > e.max_number()
+        {
+            return Err(RobotError::invalid(
+                "pump.enable_output",
+                format!(
+                    "{e:?}: the controller has outputs 0..={} of this kind",
+                    e.max_number()
+                ),
+            ));
+        }
+        if !(self.flow_factor.is_finite() && self.flow_factor > 0.0) {
+            return Err(RobotError::invalid(
+                "pump.flow_factor",
+                format!(
+                    "{}: must be finite and > 0 (output ratio per L/min)",
+                    self.flow_factor
+                ),
+            ));
+        }
+        if !(self.flow_offset.is_finite() && (0.0..1.0).contains(&self.flow_offset)) {
+            return Err(RobotError::invalid(
+                "pump.flow_offset",
+                format!("{}: must be in [0, 1) (output ratio)", self.flow_offset),
+            ));
+        }
+        if !(self.prime_dwell.is_finite() && self.prime_dwell >= 0.0) {
+            return Err(RobotError::invalid(
+                "pump.prime_dwell",
+                format!("{} s: must be finite and ≥ 0", self.prime_dwell),
+            ));
+        }
+        let h = self.hold();
+        if !(h.is_finite() && (0.0..=1.0).contains(&h)) {
+            return Err(RobotError::invalid(
+                "pump.hold_output",
+                format!("{h}: must be in [0, 1] (output ratio)"),
+            ));
+        }
+        let top = self.output_for_flow(max_flow_m3s);
+        if top > 1.0 {
+            return Err(RobotError::invalid(
+                "pump.flow_factor",
+                format!(
+                    "the design flow {:.4} L/min needs output {top:.3} > 1 (the full range): lower flow_factor or flow_offset",
+                    max_flow_m3s * 60_000.0
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Per-layer waits used when no schedule supplies them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WaitOptions {
+    /// Minimum time (s) from the start of a layer to the start of the next; a shorter layer is
+    /// followed by a pause. 0 = no waits.
+    pub min_layer_time: f64,
+}
+
+impl Default for WaitOptions {
+    fn default() -> Self {
+        WaitOptions {
+            min_layer_time: 0.0,
         }
     }
 }
@@ -267,34 +508,45 @@ impl Default for PlanOptions {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ProgramOptions {
-    /// Standard digital output switching the pump.
-    pub pump_output: u8,
-    /// Pump lead time (s) before the first print move of a layer.
-    pub pump_lead: f64,
     /// Blend radius (m) of `movep` along a layer (keep < half the point spacing).
     pub blend_radius: f64,
     /// Tool acceleration (m/s²) of `movep`/`movel`.
     pub tool_acceleration: f64,
-    /// `movej` joint speed (rad/s) and acceleration (rad/s²).
+    /// `movej` joint speed (rad/s) and acceleration (rad/s²) of approach moves.
     pub joint_speed: f64,
     pub joint_acceleration: f64,
     /// Use `movel` instead of `movep` along layers.
     pub use_movel: bool,
-    /// Most moves per subprogram (long programs fail on the controller above ~1–2.5 k targets).
+    /// Most motion targets (move commands) per program file: controllers fail on long files
+    /// above ~1–2.5 k targets (robot.md §4). Programs are cut at layer boundaries.
+    #[serde(alias = "max_targets")]
     pub max_moves_per_program: usize,
+    /// Distance (m) of the safe approach pose behind the first target along the tool axis.
+    pub approach_distance: f64,
+    /// Tool speed (m/s) of the `movel` from the approach pose down to the first target.
+    pub approach_speed: f64,
+    /// Time (s) to load and start the next program file within a station (a pause that keeps
+    /// the pump primed).
+    pub program_switch_time: f64,
+    /// Payload (kg) and its centre of gravity (m, flange frame) for `set_payload`.
+    pub payload_mass: f64,
+    pub payload_cog: [f64; 3],
 }
 
 impl Default for ProgramOptions {
     fn default() -> Self {
         ProgramOptions {
-            pump_output: 0,
-            pump_lead: 0.5,
             blend_radius: 0.002,
             tool_acceleration: 1.2,
             joint_speed: 0.5,
             joint_acceleration: 1.0,
             use_movel: false,
             max_moves_per_program: 1000,
+            approach_distance: 0.05,
+            approach_speed: 0.05,
+            program_switch_time: 10.0,
+            payload_mass: 3.0,
+            payload_cog: [0.0, 0.0, 0.1],
         }
     }
 }

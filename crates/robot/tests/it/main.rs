@@ -6,3 +6,4 @@ mod common;
 mod kinematics;
 mod ladder;
 mod plan;
+mod program;

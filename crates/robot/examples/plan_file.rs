@@ -1,0 +1,64 @@
+//! Plan, time and write the programs of a print given as JSON `{layers, setup, options}` (e.g.
+//! dumped from a design), printing the stage times:
+//! `cargo run --release -p kappe-robot --example plan_file -- INPUTS.json [OUT_DIR]`.
+
+use std::time::Instant;
+
+use kappe_robot::*;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let path = std::env::args()
+        .nth(1)
+        .ok_or("usage: plan_file INPUTS.json [OUT_DIR]")?;
+    let out = std::env::args().nth(2);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path)?)?;
+    let layers: Vec<PrintLayer> = serde_json::from_value(v["layers"].clone())?;
+    let setup: RobotSetup = serde_json::from_value(v["setup"].clone())?;
+    let opts: PlanOptions = serde_json::from_value(v["options"].clone())?;
+    let t = Instant::now();
+    let plan = plan_print(&layers, &setup, &opts)?;
+    let t_plan = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let files = program_files(&plan, "program_part")?;
+    let t_prog = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    for f in &files {
+        let rep = lint(&f.text, plan.options.program.max_moves_per_program);
+        if !rep.ok() {
+            return Err(format!("{}: {:?}", f.name, rep.problems).into());
+        }
+    }
+    let t_lint = t.elapsed().as_secs_f64();
+    println!(
+        "stations {}, waypoints {}, parts {}, print {:.1} s, total {:.1} s, max v ratio {:.3}, max a ratio {:.3}, slowdowns {}",
+        plan.stations.len(),
+        plan.waypoint_count(),
+        files.len(),
+        plan.print_time,
+        plan.total_time,
+        plan.max_speed_ratio,
+        plan.max_acceleration_ratio,
+        plan.slowdowns.len()
+    );
+    for s in plan.slowdowns.iter().take(10) {
+        println!("  {s:?}");
+    }
+    println!(
+        "| plan + timing + check | programs | lint | total |\n|---|---|---|---|\n| {t_plan:.3} s | {t_prog:.3} s | {t_lint:.3} s | {:.3} s |",
+        t_plan + t_prog + t_lint
+    );
+    if let Some(dir) = out {
+        std::fs::create_dir_all(&dir)?;
+        for f in &files {
+            std::fs::write(format!("{dir}/{}", f.name), &f.text)?;
+        }
+        std::fs::write(format!("{dir}/programs.json"), index_json(&files))?;
+        let mut csv = Vec::new();
+        write_trajectory_csv(&plan, &mut csv)?;
+        std::fs::write(format!("{dir}/trajectory.csv"), csv)?;
+        let mut json = Vec::new();
+        write_plan_json(&plan, &mut json)?;
+        std::fs::write(format!("{dir}/plan.json"), json)?;
+    }
+    Ok(())
+}

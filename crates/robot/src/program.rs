@@ -1,0 +1,515 @@
+//! Controller-sized URScript programs (robot.md §4; issue 13): the print is cut, at layer
+//! boundaries, into standalone programs of at most `max_moves_per_program` motion targets. Each
+//! is a complete program (`def … end` and the call, TCP, payload, I/O set-up, an approach move)
+//! and an index lists them in order with the station (base pose) each needs.
+//!
+//! The bead is continuous within a station: the pump is enabled once, at the station's first
+//! target, primed for `prime_dwell`, and switched off after the station's last target. The flow
+//! set-point (an analog output, proportional to lw·lh·v) is set wherever the planned speed
+//! changes. Pauses (layer waits, the change to the next program file inside a station) keep the
+//! pump primed at the hold output, or stop it and prime again, as configured.
+//!
+//! Hand-written: no crate writes URScript.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::RobotError;
+use crate::frames::Iso;
+use crate::kinematics::{JOINT_LIMITS, Joints, UR10E, joint_delta, within_limits};
+use crate::plan::Plan;
+use crate::setup::{AnalogDomain, PauseMode};
+
+/// One program file: a contiguous range of layers of one station.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProgramPart {
+    pub station: usize,
+    /// Layer slots (indices into the station's `layers`), inclusive.
+    pub first: usize,
+    pub last: usize,
+    /// Their layer ids.
+    pub first_layer: i64,
+    pub last_layer: i64,
+    /// Motion targets (move commands) in the file.
+    pub targets: usize,
+    /// The part starts the station: approach from the safe pose and prime the pump.
+    pub starts_station: bool,
+    /// The part ends the station: pump off and retract.
+    pub ends_station: bool,
+}
+
+/// Targets of a part: approach `movej` + `movel` and the other points (starting a station), or
+/// a `movej` to where the previous part stopped and every point (continuing); + the retract.
+fn part_targets(points: usize, starts: bool, ends: bool) -> usize {
+    let body = if starts { 2 + points - 1 } else { 1 + points };
+    body + usize::from(ends)
+}
+
+/// Cut the plan into program parts: whole layers, at most `max_moves_per_program` targets each.
+pub fn split_parts(plan: &Plan) -> Result<Vec<ProgramPart>, RobotError> {
+    let max = plan.options.program.max_moves_per_program;
+    let mut parts = Vec::new();
+    for (si, st) in plan.stations.iter().enumerate() {
+        let n = st.layers.len();
+        let mut first = 0usize;
+        while first < n {
+            let mut last = first;
+            let mut points = 0usize;
+            let starts = first == 0;
+            loop {
+                let p = points + st.layers[last].waypoints.len();
+                if part_targets(p, starts, last + 1 == n) > max {
+                    break;
+                }
+                points = p;
+                if last + 1 == n {
+                    last += 1;
+                    break;
+                }
+                last += 1;
+            }
+            if last == first {
+                let l = &st.layers[first];
+                return Err(RobotError::invalid(
+                    "program.max_moves_per_program",
+                    format!(
+                        "{max} targets per program is below what layer {} needs ({} points + {} approach/retract moves); raise it to at least {}",
+                        l.layer,
+                        l.waypoints.len(),
+                        part_targets(l.waypoints.len(), true, true) - l.waypoints.len(),
+                        part_targets(l.waypoints.len(), true, true)
+                    ),
+                ));
+            }
+            let lastslot = last - 1;
+            parts.push(ProgramPart {
+                station: si,
+                first,
+                last: lastslot,
+                first_layer: st.layers[first].layer,
+                last_layer: st.layers[lastslot].layer,
+                targets: part_targets(points, starts, last == n),
+                starts_station: starts,
+                ends_station: last == n,
+            });
+            first = last;
+        }
+    }
+    Ok(parts)
+}
+
+fn joints(q: &[f64; 6]) -> String {
+    let v: Vec<String> = q.iter().map(|x| format!("{x:.9}")).collect();
+    format!("[{}]", v.join(", "))
+}
+
+fn pose(t: &Iso) -> String {
+    let r = t.rotation_vector();
+    format!(
+        "p[{:.9}, {:.9}, {:.9}, {:.9}, {:.9}, {:.9}]",
+        t.t.x, t.t.y, t.t.z, r.x, r.y, r.z
+    )
+}
+
+fn num(x: f64) -> String {
+    // Six decimals: 1 µm, 1 µs, 1e-6 of the output range.
+    let s = format!("{x:.6}");
+    if s == "-0.000000" {
+        "0.000000".into()
+    } else {
+        s
+    }
+}
+
+/// The safe approach configuration: the first target backed off `dist` along the tool axis,
+/// the IK solution nearest `q` (same branch), unwrapped next to `q`.
+fn approach_config(q: &Joints, tool: &Iso, dist: f64) -> Result<Joints, RobotError> {
+    let tcp = UR10E.fk(q).mul(tool);
+    let back = tcp.mul(&Iso::translation(0.0, 0.0, -dist));
+    let flange = back.mul(&tool.inverse());
+    let sols = UR10E.ik(&flange);
+    let mut best: Option<(f64, Joints)> = None;
+    for s in sols.as_slice() {
+        let d = joint_delta(q, s);
+        let cand: Joints = std::array::from_fn(|j| q[j] + d[j]);
+        if !within_limits(&cand, &JOINT_LIMITS) {
+            continue;
+        }
+        let c: f64 = d.iter().map(|v| v * v).sum();
+        if best.is_none_or(|b| c < b.0) {
+            best = Some((c, cand));
+        }
+    }
+    best.map(|b| b.1).ok_or_else(|| {
+        RobotError::invalid(
+            "program.approach_distance",
+            format!(
+                "no joint configuration reaches the approach pose {dist} m behind the target {:?}",
+                tcp.t.to_array()
+            ),
+        )
+    })
+}
+
+/// One program file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ProgramFile {
+    /// File name (`<prefix>NN.script`).
+    pub name: String,
+    pub part: ProgramPart,
+    /// `world_from_base` of the station, row-major.
+    pub world_from_base: crate::frames::Mat4,
+    /// Plan times (s): arrival at the first and last target.
+    pub start: f64,
+    pub end: f64,
+    #[serde(skip)]
+    pub text: String,
+}
+
+/// The flow set-point (output ratio) for tool speed `v` (m/s).
+pub fn flow_output(plan: &Plan, v: f64) -> f64 {
+    let o = &plan.options;
+    let q = 4.0 * o.bead_radius * o.bead_offset.abs() * v;
+    o.pump.output_for_flow(q)
+}
+
+/// All program files of a timed plan, named `<prefix>01.script`, … in order.
+pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, RobotError> {
+    let o = &plan.options;
+    let pr = &o.program;
+    let pump = &o.pump;
+    let tool = Iso::from_mat4(&plan.flange_from_tcp)
+        .map_err(|e| RobotError::invalid("flange_from_tcp", e))?;
+    let n_parts = plan.parts.len();
+    let mut files = Vec::new();
+    let aout = |v: f64| format!("set_standard_analog_out({}, {})", pump.flow_output, num(v));
+    let enable = |on: bool| pump.enable_output.map(|e| e.call(on));
+    for (pi, part) in plan.parts.iter().enumerate() {
+        let st = plan
+            .stations
+            .get(part.station)
+            .ok_or_else(|| RobotError::invalid("parts", "names a station the plan lacks"))?;
+        let layers = st
+            .layers
+            .get(part.first..=part.last)
+            .ok_or_else(|| RobotError::invalid("parts", "names layers the station lacks"))?;
+        let fname = format!("{prefix}{:02}.script", pi + 1);
+        let func = format!("kappe_part_{:02}", pi + 1);
+        let mut w = String::new();
+        let mut line = |s: &str| {
+            w.push_str("  ");
+            w.push_str(s);
+            w.push('\n');
+        };
+        let b = &st.world_from_base;
+        let mut targets = 0usize;
+        let first_wp = layers
+            .first()
+            .and_then(|l| l.waypoints.first())
+            .ok_or_else(|| RobotError::invalid("parts", "an empty layer"))?;
+        let last_wp = layers
+            .last()
+            .and_then(|l| l.waypoints.last())
+            .ok_or_else(|| RobotError::invalid("parts", "an empty layer"))?;
+        line(&format!("set_tcp({})", pose(&tool)));
+        line(&format!(
+            "set_payload({}, [{}, {}, {}])",
+            num(pr.payload_mass),
+            num(pr.payload_cog[0]),
+            num(pr.payload_cog[1]),
+            num(pr.payload_cog[2])
+        ));
+        let domain = match pump.flow_domain {
+            AnalogDomain::Current => 0,
+            AnalogDomain::Voltage => 1,
+        };
+        line(&format!(
+            "set_analog_outputdomain({}, {domain})",
+            pump.flow_output
+        ));
+        let mut flow_now: f64;
+        if part.starts_station {
+            line(&aout(0.0));
+            if let Some(s) = enable(false) {
+                line(&s);
+            }
+            let qa = approach_config(&first_wp.q, &tool, pr.approach_distance)?;
+            line(&format!(
+                "# approach: safe pose {} m behind the first target, then down to it",
+                num(pr.approach_distance)
+            ));
+            line(&format!(
+                "movej({}, a={}, v={})",
+                joints(&qa),
+                num(pr.joint_acceleration),
+                num(pr.joint_speed)
+            ));
+            line(&format!(
+                "movel({}, a={}, v={})",
+                pose(&UR10E.fk(&first_wp.q).mul(&tool)),
+                num(pr.tool_acceleration),
+                num(pr.approach_speed)
+            ));
+            targets += 2;
+            let v1 = layers
+                .iter()
+                .flat_map(|l| &l.waypoints)
+                .nth(1)
+                .map_or(o.print_speed, |w| w.speed);
+            flow_now = flow_output(plan, v1);
+            line(&format!(
+                "# prime: pump on, {} s at the first move's flow",
+                num(pump.prime_dwell)
+            ));
+            line(&aout(flow_now));
+            if let Some(s) = enable(true) {
+                line(&s);
+            }
+            line(&format!("sleep({})", num(pump.prime_dwell)));
+        } else {
+            // The previous part stopped at the end of the previous layer, pump primed.
+            let prev = part
+                .first
+                .checked_sub(1)
+                .and_then(|i| st.layers.get(i))
+                .and_then(|l| l.waypoints.last())
+                .ok_or_else(|| {
+                    RobotError::invalid("parts", "a continuing part without a previous layer")
+                })?;
+            line("# continue the bead where the previous program stopped (pump primed)");
+            line(&format!(
+                "movej({}, a={}, v={})",
+                joints(&prev.q),
+                num(pr.joint_acceleration),
+                num(pr.joint_speed)
+            ));
+            targets += 1;
+            if pump.pause == PauseMode::Stop {
+                line(&aout(flow_output(plan, first_wp.speed)));
+                if let Some(s) = enable(true) {
+                    line(&s);
+                }
+                line(&format!("sleep({})", num(pump.prime_dwell)));
+            }
+            flow_now = f64::NAN;
+        }
+        let cmd = if pr.use_movel { "movel" } else { "movep" };
+        let n_layers = layers.len();
+        for (li, l) in layers.iter().enumerate() {
+            line(&format!(
+                "# layer {} ({} points)",
+                l.layer,
+                l.waypoints.len()
+            ));
+            for (k, wp) in l.waypoints.iter().enumerate() {
+                if part.starts_station && li == 0 && k == 0 {
+                    continue;
+                }
+                let f = flow_output(plan, wp.speed);
+                // 1e-4 of the range: below any analog output's resolution.
+                if flow_now.is_nan() || (f - flow_now).abs() > 1e-4 {
+                    line(&aout(f));
+                    flow_now = f;
+                }
+                let is_last = k + 1 == l.waypoints.len();
+                let stop = is_last && (wp.hold > 0.0 || li + 1 == n_layers);
+                let r = if stop { 0.0 } else { pr.blend_radius };
+                line(&format!(
+                    "{cmd}({}, a={}, v={}, r={})",
+                    pose(&UR10E.fk(&wp.q).mul(&tool)),
+                    num(pr.tool_acceleration),
+                    num(wp.speed),
+                    num(r)
+                ));
+                targets += 1;
+            }
+            let last_of_part = li + 1 == n_layers;
+            if last_of_part {
+                break;
+            }
+            if l.wait > 0.0 || l.waypoints.last().is_some_and(|w| w.hold > 0.0) {
+                let hold = l.waypoints.last().map_or(0.0, |w| w.hold);
+                match pump.pause {
+                    PauseMode::KeepPrimed => {
+                        line(&format!("# pause {} s, pump primed", num(hold)));
+                        line(&aout(pump.hold()));
+                        line(&format!("sleep({})", num(hold)));
+                    }
+                    PauseMode::Stop => {
+                        line(&format!(
+                            "# pause {} s, pump stopped, then primed again",
+                            num(hold)
+                        ));
+                        line(&aout(0.0));
+                        if let Some(s) = enable(false) {
+                            line(&s);
+                        }
+                        line(&format!("sleep({})", num(hold - pump.prime_dwell)));
+                        line(&aout(flow_output(plan, o.print_speed)));
+                        if let Some(s) = enable(true) {
+                            line(&s);
+                        }
+                        line(&format!("sleep({})", num(pump.prime_dwell)));
+                    }
+                }
+                flow_now = f64::NAN;
+            }
+        }
+        if part.ends_station {
+            line("# station done: pump off, retract");
+            line(&aout(0.0));
+            if let Some(s) = enable(false) {
+                line(&s);
+            }
+            let back = UR10E.fk(&last_wp.q).mul(&tool).mul(&Iso::translation(
+                0.0,
+                0.0,
+                -pr.approach_distance,
+            ));
+            line(&format!(
+                "movel({}, a={}, v={})",
+                pose(&back),
+                num(pr.tool_acceleration),
+                num(pr.approach_speed)
+            ));
+            targets += 1;
+        } else {
+            let last_layer = layers.last().map(|l| (l.wait, l.waypoints.last()));
+            let wait = last_layer.map_or(0.0, |x| x.0);
+            match pump.pause {
+                PauseMode::KeepPrimed => {
+                    line("# the next program continues this station's bead: pump stays primed");
+                    line(&aout(pump.hold()));
+                    if wait > 0.0 {
+                        line(&format!("sleep({})", num(wait)));
+                    }
+                }
+                PauseMode::Stop => {
+                    line(
+                        "# the next program continues this station: pump stopped, primed again there",
+                    );
+                    line(&aout(0.0));
+                    if let Some(s) = enable(false) {
+                        line(&s);
+                    }
+                    if wait > 0.0 {
+                        line(&format!("sleep({})", num(wait)));
+                    }
+                }
+            }
+        }
+        if targets != part.targets {
+            return Err(RobotError::Verification(vec![format!(
+                "{fname}: wrote {targets} motion targets, the part was sized for {}",
+                part.targets
+            )]));
+        }
+        let mut text = String::new();
+        text.push_str(&format!(
+            "# Kappe print program {}/{} for a UR10e (generated; verified by kappe-robot check)\n",
+            pi + 1,
+            n_parts
+        ));
+        text.push_str(&format!(
+            "# station {} (world_from_base rows {:?}), layers {}..{}, {} motion targets\n",
+            part.station + 1,
+            b,
+            part.first_layer,
+            part.last_layer,
+            targets
+        ));
+        text.push_str(&format!(
+            "# plan time {:.3} s to {:.3} s; units m, rad, s; poses in the robot base frame\n",
+            first_wp.t, last_wp.t
+        ));
+        text.push_str(&format!("def {func}():\n"));
+        text.push_str(&w);
+        text.push_str("end\n");
+        text.push_str(&format!("{func}()\n"));
+        files.push(ProgramFile {
+            name: fname,
+            part: part.clone(),
+            world_from_base: *b,
+            start: first_wp.t,
+            end: last_wp.t,
+            text,
+        });
+    }
+    Ok(files)
+}
+
+/// The index of the program files (JSON): in order, each with its station, base pose, layers,
+/// targets and plan times.
+pub fn index_json(files: &[ProgramFile]) -> String {
+    let list: Vec<serde_json::Value> = files
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let m = &f.world_from_base;
+            serde_json::json!({
+                "order": i + 1,
+                "file": f.name,
+                "station": f.part.station + 1,
+                "base_x_m": m[0][3],
+                "base_y_m": m[1][3],
+                "base_z_m": m[2][3],
+                "base_yaw_deg": m[1][0].atan2(m[0][0]).to_degrees(),
+                "world_from_base": m,
+                "first_layer": f.part.first_layer,
+                "last_layer": f.part.last_layer,
+                "targets": f.part.targets,
+                "starts_station": f.part.starts_station,
+                "ends_station": f.part.ends_station,
+                "start_s": f.start,
+                "end_s": f.end,
+            })
+        })
+        .collect();
+    serde_json::to_string_pretty(&serde_json::json!({ "programs": list }))
+        .unwrap_or_else(|_| "{}".into())
+}
+
+/// The plan that continues the print from layer `layer` (its first target first): the layers
+/// before it are dropped, the station holding it starts there (approach from the safe pose,
+/// prime), the programs are cut again and everything is re-timed from 0.
+pub fn resume_plan(plan: &Plan, layer: i64) -> Result<Plan, RobotError> {
+    let mut found = None;
+    for (si, st) in plan.stations.iter().enumerate() {
+        if let Some(li) = st.layers.iter().position(|l| l.layer == layer) {
+            found = Some((si, li));
+            break;
+        }
+    }
+    let Some((si, li)) = found else {
+        let ids: Vec<i64> = plan
+            .stations
+            .iter()
+            .flat_map(|s| &s.layers)
+            .map(|l| l.layer)
+            .collect();
+        return Err(RobotError::invalid(
+            "--from-layer",
+            format!(
+                "layer {layer} is not in the plan (its layers are {}..={})",
+                ids.first().copied().unwrap_or(0),
+                ids.last().copied().unwrap_or(0)
+            ),
+        ));
+    };
+    let mut out = plan.clone();
+    out.stations.drain(..si);
+    if let Some(st) = out.stations.first_mut() {
+        st.layers.drain(..li);
+    }
+    let waits: Vec<crate::timing::LayerWait> = out
+        .stations
+        .iter()
+        .flat_map(|s| &s.layers)
+        .map(|l| crate::timing::LayerWait {
+            layer: l.layer,
+            wait: l.wait,
+        })
+        .collect();
+    out.parts = split_parts(&out)?;
+    crate::timing::apply_timing(&mut out, Some(&waits))?;
+    Ok(out)
+}
