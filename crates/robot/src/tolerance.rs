@@ -1,0 +1,285 @@
+//! Base-pose tolerance: a relocated mobile base is never exactly where the plan put it. After a
+//! drive the base is localised (measured) and the controller re-solves the joints for the same
+//! nozzle targets from the measured pose, so what must survive a pose error is not the joint
+//! trajectory but its *feasibility*: every target reachable with a valid configuration on the
+//! planned IK branch, joint limits and singularity margins kept, clearance to the environment at
+//! least the plan's margin, and the mobile-base body clear of every static obstacle.
+//!
+//! [`check_base_tolerance`] checks this for every station of a plan over the box of base-pose
+//! errors `|dx|, |dy| ≤ position`, `|dyaw| ≤ yaw` (the base drives on the floor: z, roll and pitch
+//! are fixed by the floor and the platform). It samples the 8 corners of that box and its centre.
+//! Why corners suffice: the errors are small (≤ 10 mm, ≤ 1° by default) against the lengths that
+//! set the clearances (links ~0.6 m, distances ≥ 10 mm), so every clearance is, to first order, an
+//! affine function of (dx, dy, dyaw), and an affine function takes its minimum over a box at a
+//! corner. The mobile-base body is rigid with the base, so its clearance is checked exactly at the
+//! corners too (a box's distance to a fixed box is minimised at an extreme pose for small
+//! rotations, by the same argument).
+//!
+//! Per corner and waypoint the valid IK configurations are those the planner itself accepts
+//! ([`crate::plan`]: limits, singularity margins, self-collision, clearance ≥ the plan's margin,
+//! printed layers as obstacles); the one nearest the planned joints on the same elbow/wrist branch
+//! is taken, and consecutive ones must stay within the plan's compatibility ε (the trajectory is
+//! re-solvable without a reconfiguration). Hand-written: it is a property of this planner's
+//! acceptance rules, which no crate knows.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::collision::{Obstacle, Scene};
+use crate::frames::Iso;
+use crate::kinematics::joint_delta;
+use crate::plan::{Plan, validate};
+use crate::setup::{PathPoint, PrintLayer};
+
+/// The base-pose errors a plan must tolerate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BaseTolerance {
+    /// Largest position error of the base in x and y, m (default 0.010).
+    pub position: f64,
+    /// Largest yaw error of the base, degrees (default 1.0).
+    pub yaw_deg: f64,
+    /// Check every n-th waypoint of a layer (and always its first and last); 1 = every waypoint.
+    pub stride: usize,
+}
+
+impl Default for BaseTolerance {
+    fn default() -> Self {
+        BaseTolerance {
+            position: 0.010,
+            yaw_deg: 1.0,
+            stride: 1,
+        }
+    }
+}
+
+/// The result of [`check_base_tolerance`]; the plan tolerates the errors when `problems` is empty.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ToleranceReport {
+    /// The tolerance checked.
+    pub tolerance: BaseTolerance,
+    /// Perturbed base poses checked (per station).
+    pub poses_per_station: usize,
+    /// Waypoints re-solved, over all poses.
+    pub waypoints_checked: usize,
+    /// Smallest clearance of the arm to the environment over all perturbed poses, m.
+    pub min_clearance: f64,
+    /// Smallest distance of the mobile-base body to a static obstacle over all perturbed poses,
+    /// m (`None` without obstacles or body).
+    pub min_body_distance: Option<f64>,
+    /// What fails, at most 20 entries.
+    pub problems: Vec<String>,
+}
+
+impl ToleranceReport {
+    /// No problem found.
+    pub fn ok(&self) -> bool {
+        self.problems.is_empty()
+    }
+}
+
+/// The 9 sampled base errors `(dx, dy, dyaw)`: the box's corners and its centre.
+pub fn sampled_errors(tol: &BaseTolerance) -> Vec<(f64, f64, f64)> {
+    let (p, a) = (tol.position, tol.yaw_deg.to_radians());
+    let mut out = vec![(0.0, 0.0, 0.0)];
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sa in [-1.0, 1.0] {
+                out.push((sx * p, sy * p, sa * a));
+            }
+        }
+    }
+    out
+}
+
+/// Check every station of `plan` under base-pose errors up to `tol` (see the module docs).
+pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport {
+    let mut rep = ToleranceReport {
+        tolerance: tol.clone(),
+        min_clearance: f64::INFINITY,
+        ..Default::default()
+    };
+    let position_ok = tol.position.is_finite() && tol.position >= 0.0;
+    let yaw_ok = tol.yaw_deg.is_finite() && tol.yaw_deg >= 0.0;
+    if !position_ok || !yaw_ok || tol.stride == 0 {
+        rep.problems.push(format!(
+            "base tolerance position {} m, yaw {}°, stride {}: need finite values ≥ 0 and stride ≥ 1",
+            tol.position, tol.yaw_deg, tol.stride
+        ));
+        return rep;
+    }
+    let layers: Vec<PrintLayer> = plan
+        .stations
+        .iter()
+        .flat_map(|s| &s.layers)
+        .map(|l| PrintLayer {
+            layer: l.layer,
+            points: l
+                .waypoints
+                .iter()
+                .map(|w| PathPoint {
+                    index: w.index,
+                    position: w.position,
+                    axis: w.axis,
+                })
+                .collect(),
+        })
+        .collect();
+    let ctx = match validate(&layers, &plan.setup, &plan.options) {
+        Ok(c) => c,
+        Err(e) => {
+            rep.problems
+                .push(format!("the plan's setup or targets are invalid: {e}"));
+            return rep;
+        }
+    };
+    let errors = sampled_errors(tol);
+    rep.poses_per_station = errors.len();
+
+    // Print order of the first layer of every station.
+    let mut first_order = Vec::with_capacity(plan.stations.len());
+    let mut o = 0usize;
+    for st in &plan.stations {
+        first_order.push(o);
+        o += st.layers.len();
+    }
+    struct PoseResult {
+        checked: usize,
+        min_clearance: f64,
+        min_body: Option<f64>,
+        problems: Vec<String>,
+    }
+    let jobs: Vec<(usize, (f64, f64, f64))> = (0..plan.stations.len())
+        .flat_map(|s| errors.iter().map(move |e| (s, *e)))
+        .collect();
+    let results: Vec<PoseResult> = jobs
+        .par_iter()
+        .map(|&(si, (dx, dy, da))| {
+            let mut r = PoseResult {
+                checked: 0,
+                min_clearance: f64::INFINITY,
+                min_body: None,
+                problems: Vec::new(),
+            };
+            let st = &plan.stations[si];
+            let Ok(nominal) = Iso::from_mat4(&st.world_from_base) else {
+                r.problems
+                    .push(format!("station {si}: world_from_base is not a rigid transform"));
+                return r;
+            };
+            // The error is a drive error: a shift on the floor and a turn about the base's own
+            // vertical axis.
+            let world_from_base = Iso::translation(dx, dy, 0.0)
+                .mul(&nominal)
+                .mul(&Iso::rot_z(da));
+            let at = format!(
+                "station {si}, base off by ({:+.1} mm, {:+.1} mm, {:+.2}°)",
+                dx * 1e3,
+                dy * 1e3,
+                da.to_degrees()
+            );
+            if let Err(e) = ctx.check_base(&world_from_base) {
+                r.problems.push(format!("{at}: {e}"));
+            }
+            {
+                for b in &plan.setup.mobile_base {
+                    let body = b.to_world(&world_from_base);
+                    let Ok(body_scene) = Scene::new(std::slice::from_ref(&body)) else {
+                        continue;
+                    };
+                    for ob in &plan.setup.obstacles {
+                        if matches!(ob, Obstacle::HalfSpace { .. }) {
+                            continue;
+                        }
+                        if let Some(d) = body_scene.distance_to(ob) {
+                            r.min_body = Some(r.min_body.map_or(d, |m: f64| m.min(d)));
+                            if d <= 0.0 {
+                                r.problems.push(format!(
+                                    "{at}: the mobile base body {:?} touches {:?} (distance {:.4} m)",
+                                    b.name,
+                                    ob.name(),
+                                    d
+                                ));
+                            }
+                        }
+                    }
+                }
+            }
+            let scene = match ctx.scene(&world_from_base) {
+                Ok(s) => s,
+                Err(e) => {
+                    r.problems.push(format!("{at}: {e}"));
+                    return r;
+                }
+            };
+            let inv = world_from_base.inverse();
+            let eps = plan.options.epsilon;
+            for (li, l) in st.layers.iter().enumerate() {
+                let order = first_order[si] + li;
+                let Some(layer) = ctx.layers.get(order) else {
+                    continue;
+                };
+                let n = l.waypoints.len();
+                let mut prev: Option<[f64; 6]> = None;
+                for (k, w) in l.waypoints.iter().enumerate() {
+                    if k % tol.stride != 0 && k + 1 != n {
+                        continue;
+                    }
+                    r.checked += 1;
+                    let frame = ctx.target_frame(layer, k);
+                    let (verts, rej) = ctx.vertices(&scene, &inv, &world_from_base, &frame, order);
+                    let branch = |q: &[f64; 6]| (q[2].sin() > 0.0, q[4].sin() > 0.0);
+                    let best = verts
+                        .iter()
+                        .filter(|v| branch(&v.q) == branch(&w.q))
+                        .map(|v| {
+                            let d2: f64 = joint_delta(&w.q, &v.q).iter().map(|d| d * d).sum();
+                            (d2, v)
+                        })
+                        .min_by(|a, b| a.0.total_cmp(&b.0));
+                    match best {
+                        None => {
+                            let (_, detail) = rej.failure();
+                            r.problems.push(format!(
+                                "{at}: layer {} point {} has no valid configuration on the planned branch ({detail})",
+                                l.layer, w.index
+                            ));
+                            prev = None;
+                        }
+                        Some((_, v)) => {
+                            r.min_clearance = r.min_clearance.min(v.clearance);
+                            if let Some(p) = prev {
+                                let step: f64 = joint_delta(&p, &v.q).iter().map(|d| d * d).sum();
+                                // Only consecutive checked points are compared: with a stride the
+                                // allowed motion grows with the number of steps skipped.
+                                let allowed = eps * (tol.stride.min(n) as f64).powi(2);
+                                if step > allowed {
+                                    r.problems.push(format!(
+                                        "{at}: layer {} point {}: the re-solved joints jump by Σ Δq² = {step:.4} rad² (> ε = {allowed:.4})",
+                                        l.layer, w.index
+                                    ));
+                                }
+                            }
+                            prev = Some(v.q);
+                        }
+                    }
+                }
+            }
+            r
+        })
+        .collect();
+    for r in results {
+        rep.waypoints_checked += r.checked;
+        rep.min_clearance = rep.min_clearance.min(r.min_clearance);
+        if let Some(b) = r.min_body {
+            rep.min_body_distance = Some(rep.min_body_distance.map_or(b, |m| m.min(b)));
+        }
+        rep.problems.extend(r.problems);
+    }
+    let n = rep.problems.len();
+    if n > 20 {
+        rep.problems.truncate(20);
+        rep.problems.push(format!("… and {} more", n - 20));
+    }
+    rep
+}
