@@ -16,10 +16,13 @@ pub mod export;
 pub mod frames;
 pub mod kinematics;
 pub mod ladder;
+pub mod lint;
 pub mod plan;
+pub mod program;
 pub mod setup;
 pub mod stations;
 pub mod synthetic;
+pub mod timing;
 pub mod tolerance;
 
 pub use check::{CheckReport, check_plan};
@@ -27,8 +30,11 @@ pub use error::{FailureKind, PlanFailure, RobotError};
 pub use export::{urscript_programs, write_plan_json, write_trajectory_csv, write_urscript};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
-pub use plan::{LayerPlan, Plan, Station, Waypoint, plan_print};
+pub use lint::{LintReport, lint};
+pub use plan::{LayerPlan, Plan, Station, Waypoint, plan_print, plan_print_with_waits};
+pub use program::{ProgramFile, ProgramPart, index_json, program_files, resume_plan};
 pub use setup::{
     BasePlacement, BaseSearch, PathPoint, PlanOptions, PlannerKind, PrintLayer, ProgramOptions,
     RobotSetup, Tool, ToolCapsule,
 };
+pub use timing::{LayerTime, LayerWait, Slowdown, apply_timing, layer_times};
