@@ -4,6 +4,7 @@
 //! writes files atomically and prints. Each subcommand lives in `cmd/<name>.rs`.
 
 mod cmd;
+mod exit;
 mod output;
 mod report_input;
 
@@ -12,7 +13,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "kappe", version, about, long_about = None)]
+#[command(name = "kappe", version, about, long_about = None, after_help = EXIT_HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -41,8 +42,12 @@ enum Command {
     Optimize(cmd::optimize::OptimizeArgs),
 }
 
+/// The exit-status scheme, shown by `kappe --help` (see `exit.rs`).
+const EXIT_HELP: &str = "Exit status: 0 success; 1 the design or study fails its checks (or some \
+designs failed); 2 usage or input error (nothing is written); 3 internal error or I/O failure.";
+
 fn main() -> ExitCode {
-    quiet_broken_pipe();
+    exit::install_panic_hook();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Cem(c) => cmd::cem::run(c),
@@ -61,25 +66,7 @@ fn main() -> ExitCode {
             for cause in err.chain().skip(1) {
                 eprintln!("  caused by: {cause}");
             }
-            ExitCode::FAILURE
+            ExitCode::from(exit::status_of(&err))
         }
     }
-}
-
-/// `kappe design --json | head` closes stdout early; `println!` then panics with "Broken pipe".
-/// Like other Unix tools, end quietly with status 141 (128 + SIGPIPE) instead of a panic message.
-fn quiet_broken_pipe() {
-    let default = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let msg = info
-            .payload()
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| info.payload().downcast_ref::<&str>().copied())
-            .unwrap_or("");
-        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
-            std::process::exit(141);
-        }
-        default(info);
-    }));
 }

@@ -3,13 +3,14 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use kappe_cem::json::{TopologyFile, equilibrium_to_json, read_topology};
 use kappe_cem::{Equilibrium, OptimizeResult, Problem, SolverOptions};
 use serde_json::json;
 
-use crate::output::write_file_atomic;
+use crate::exit::{self, Usage};
+use crate::output::{check_user_file, write_user_file};
 
 #[derive(Subcommand)]
 pub enum CemCommand {
@@ -27,6 +28,9 @@ pub struct OptimizeArgs {
     /// Output file (written atomically); stdout when absent.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    force: bool,
     /// Write the result and exit 0 even if the optimizer stopped short of convergence.
     #[arg(long)]
     allow_partial: bool,
@@ -43,6 +47,9 @@ pub struct SolveArgs {
     /// Output file (written atomically); stdout when absent.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    force: bool,
     /// Print a short human-readable summary instead of the JSON on stdout.
     #[arg(long)]
     summary: bool,
@@ -63,7 +70,7 @@ fn load(input: Option<&Path>, example: bool) -> Result<TopologyFile> {
         return kappe_cem::example::example_arch().context("the built-in example is invalid");
     }
     let Some(path) = input else {
-        bail!("give an INPUT.json or --example");
+        return Err(Usage("give an INPUT.json or --example".into()).into());
     };
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -71,6 +78,9 @@ fn load(input: Option<&Path>, example: bool) -> Result<TopologyFile> {
 }
 
 fn solve(args: SolveArgs) -> Result<ExitCode> {
+    if let Some(out) = &args.output {
+        check_user_file(out, args.force)?;
+    }
     let file = load(args.input.as_deref(), args.example)?;
     let source = args.input.as_ref().map_or_else(
         || "built-in example".to_string(),
@@ -82,7 +92,7 @@ fn solve(args: SolveArgs) -> Result<ExitCode> {
     let mut text = serde_json::to_string_pretty(&doc).context("cannot serialize the result")?;
     text.push('\n');
     if let Some(out) = &args.output {
-        write_file_atomic(out, text.as_bytes())?;
+        write_user_file(out, text.as_bytes(), args.force)?;
     }
     if args.summary {
         print!("{}", summary(&eq, &file.solver, &source));
@@ -143,10 +153,16 @@ fn summary(eq: &Equilibrium, solver: &SolverOptions, source: &str) -> String {
 }
 
 fn optimize(args: OptimizeArgs) -> Result<ExitCode> {
+    if let Some(out) = &args.output {
+        check_user_file(out, args.force)?;
+    }
     let file = load(Some(&args.input), false)?;
     let source = args.input.display().to_string();
     let Some(block) = &file.optimization else {
-        bail!("{source} has no `optimization` block; nothing to optimize (use `kappe cem solve`)");
+        return Err(Usage(format!(
+            "{source} has no `optimization` block; nothing to optimize (use `kappe cem solve`)"
+        ))
+        .into());
     };
     let (problem, options) = Problem::from_json(block)
         .with_context(|| format!("invalid optimization block in {source}"))?;
@@ -155,11 +171,12 @@ fn optimize(args: OptimizeArgs) -> Result<ExitCode> {
     let report = optimization_report(&r);
     eprint!("{report}");
     if !r.converged && !args.allow_partial {
-        bail!(
-            "the optimizer stopped short ({}, objective {:.3e}); no output written (use --allow-partial to keep it)",
+        eprintln!(
+            "error: the optimizer stopped short ({}, objective {:.3e}); no output written (use --allow-partial to keep it)",
             r.status.name(),
             r.objective_at_x_opt
         );
+        return Ok(exit::fails());
     }
     let mut doc = equilibrium_to_json(&r.equilibrium, &options.solver, false);
     if let serde_json::Value::Object(m) = &mut doc {
@@ -190,14 +207,11 @@ fn optimize(args: OptimizeArgs) -> Result<ExitCode> {
     let mut text = serde_json::to_string_pretty(&doc).context("cannot serialize the result")?;
     text.push('\n');
     match &args.output {
-        Some(out) => write_file_atomic(out, text.as_bytes())?,
+        Some(out) => write_user_file(out, text.as_bytes(), args.force)?,
         None => print!("{text}"),
     }
-    Ok(if r.converged {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(2)
-    })
+    // Not converged here means --allow-partial was given: the user asked for status 0.
+    Ok(ExitCode::SUCCESS)
 }
 
 fn optimization_report(r: &OptimizeResult) -> String {

@@ -11,7 +11,8 @@ use kappe_fe::mesh_json::parse_mesh;
 use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, ShellModel, StaticResult};
 use serde_json::{Value, json};
 
-use crate::output::write_file_atomic;
+use crate::exit::Usage;
+use crate::output::{check_user_file, write_user_file};
 
 #[derive(Subcommand)]
 pub enum FeCommand {
@@ -28,6 +29,9 @@ pub struct BuckleArgs {
     /// Output file (written atomically); stdout when absent.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    force: bool,
     /// Number of buckling factors (lowest positive).
     #[arg(long, default_value_t = 3)]
     modes: usize,
@@ -70,6 +74,9 @@ pub struct StaticArgs {
     /// Output file (written atomically); stdout when absent.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    force: bool,
     /// Accept triangles oriented against their neighbours (results are orientation-independent;
     /// element frames then follow each triangle's own normal).
     #[arg(long)]
@@ -102,11 +109,11 @@ fn load(
     Ok(model)
 }
 
-fn emit(output: Option<&Path>, doc: &Value) -> Result<()> {
+fn emit(output: Option<&Path>, force: bool, doc: &Value) -> Result<()> {
     let mut text = serde_json::to_string_pretty(doc).context("cannot serialize the result")?;
     text.push('\n');
     match output {
-        Some(out) => write_file_atomic(out, text.as_bytes()),
+        Some(out) => write_user_file(out, text.as_bytes(), force),
         None => {
             print!("{text}");
             Ok(())
@@ -135,6 +142,9 @@ fn static_summary(s: &StaticResult) -> Value {
 
 fn buckle(args: BuckleArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
+    if let Some(out) = &args.output {
+        check_user_file(out, args.force)?;
+    }
     let model = load(&args.mesh, args.allow_mixed_orientation, args.element)?;
     let source = args.mesh.display().to_string();
     let options = BucklingOptions {
@@ -147,6 +157,18 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
         .buckling(&model, &options)
         .with_context(|| format!("buckling analysis of {source} failed"))?;
     let time_s = t0.elapsed().as_secs_f64();
+    if r.static_result.load_sum.iter().all(|v| *v == 0.0) && r.static_result.max_displacement == 0.0 {
+        return Err(Usage(format!(
+            "{source} has no load (gamma = 0 and no nodal loads): there is nothing to buckle"
+        ))
+        .into());
+    }
+    if r.factors.is_empty() {
+        eprintln!(
+            "note: no positive buckling factor: under this load the shell is nowhere in \
+             compression (reversing the load may buckle it)"
+        );
+    }
     let s = &r.stats;
     let mut doc = json!({
         "factors": r.factors,
@@ -177,12 +199,15 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
     if args.mode_shapes {
         doc["modes"] = json!(r.modes);
     }
-    emit(args.output.as_deref(), &doc)?;
+    emit(args.output.as_deref(), args.force, &doc)?;
     Ok(ExitCode::SUCCESS)
 }
 
 fn statics(args: StaticArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
+    if let Some(out) = &args.output {
+        check_user_file(out, args.force)?;
+    }
     let model = load(&args.mesh, args.allow_mixed_orientation, args.element)?;
     let source = args.mesh.display().to_string();
     let r = kappe_fe::linear_static(&model)
@@ -219,6 +244,6 @@ fn statics(args: StaticArgs) -> Result<ExitCode> {
         "elements": elements,
         "element_note": "per element, local frame rows [e1, e2, e3]; membrane_force [Nx, Ny, Nxy] N/m (tension +); moment [Mx, My, Mxy] N·m/m at the centroid; stresses Pa, top = +e3 side",
     });
-    emit(args.output.as_deref(), &doc)?;
+    emit(args.output.as_deref(), args.force, &doc)?;
     Ok(ExitCode::SUCCESS)
 }

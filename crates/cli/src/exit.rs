@@ -1,0 +1,125 @@
+//! One exit-status scheme for every command (README, `kappe --help`):
+//!
+//! | status | meaning |
+//! |---|---|
+//! | 0 | success |
+//! | 1 | the design or study fails its checks (or some designs of a study failed or could not run) |
+//! | 2 | usage or input error: bad arguments, a bad or empty input file, an output location Kappe refuses |
+//! | 3 | internal error or an I/O failure (cannot write, a solver breakdown, a panic) |
+//!
+//! Commands return `Ok(ExitCode)` for 0 and 1; every error goes through [`status_of`], which
+//! looks through the error chain for the first error whose kind it knows.
+
+use std::process::ExitCode;
+
+/// The design or study fails its checks.
+pub const FAILS: u8 = 1;
+/// Usage or input error.
+pub const USAGE: u8 = 2;
+/// Internal error or I/O failure.
+pub const INTERNAL: u8 = 3;
+
+/// Exit status for "the design (or study) fails its checks".
+pub fn fails() -> ExitCode {
+    ExitCode::from(FAILS)
+}
+
+/// A usage or input error found by the CLI itself (status 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Usage(pub String);
+
+/// A file-system failure found by the CLI itself (status 3).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct IoFailure(pub String);
+
+/// The status for an error: the first error in the chain of a known kind decides.
+pub fn status_of(err: &anyhow::Error) -> u8 {
+    for cause in err.chain() {
+        if let Some(code) = status_of_cause(cause) {
+            return code;
+        }
+    }
+    INTERNAL
+}
+
+fn status_of_cause(cause: &(dyn std::error::Error + 'static)) -> Option<u8> {
+    use kappe::DesignError;
+    use kappe_cem::CemError;
+    use kappe_fe::FeError;
+    use kappe_robot::RobotError;
+
+    if cause.is::<Usage>() {
+        return Some(USAGE);
+    }
+    if cause.is::<IoFailure>() || cause.is::<std::io::Error>() {
+        return Some(INTERNAL);
+    }
+    if cause.is::<toml::de::Error>() || cause.is::<serde_json::Error>() {
+        return Some(USAGE);
+    }
+    if let Some(e) = cause.downcast_ref::<DesignError>() {
+        return Some(match e {
+            DesignError::Parse { .. } | DesignError::Invalid { .. } => USAGE,
+            // The design as given has no equilibrium form within its bounds: it fails.
+            DesignError::FormFinding(_) => FAILS,
+            DesignError::Cem(inner) => cem_status(inner),
+            _ => INTERNAL,
+        });
+    }
+    if let Some(e) = cause.downcast_ref::<CemError>() {
+        return Some(cem_status(e));
+    }
+    if let Some(e) = cause.downcast_ref::<FeError>() {
+        return Some(match e {
+            FeError::SturmMismatch { .. }
+            | FeError::NoConvergence { .. }
+            | FeError::Numerical { .. }
+            | FeError::PatternMismatch { .. } => INTERNAL,
+            _ => USAGE,
+        });
+    }
+    if let Some(e) = cause.downcast_ref::<RobotError>() {
+        return Some(match e {
+            RobotError::Invalid { .. } => USAGE,
+            RobotError::Io(_) => INTERNAL,
+            // The robot cannot print it, or the plan fails its independent check.
+            _ => FAILS,
+        });
+    }
+    if cause.is::<kappe_report::ReportError>() {
+        return Some(INTERNAL);
+    }
+    None
+}
+
+fn cem_status(e: &kappe_cem::CemError) -> u8 {
+    use kappe_cem::CemError;
+    match e {
+        CemError::NotConverged { .. } => FAILS,
+        CemError::NumericalBreakdown { .. } => INTERNAL,
+        _ => USAGE,
+    }
+}
+
+/// Panics are internal errors: print the usual message, then exit with [`INTERNAL`] instead of
+/// Rust's 101. A closed stdout (`kappe design --json | head`) ends quietly with 141
+/// (128 + SIGPIPE), as Unix tools do.
+pub fn install_panic_hook() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+        eprintln!("error: internal error (a bug in Kappe; please report it with the input)");
+        std::process::exit(i32::from(INTERNAL));
+    }));
+}
