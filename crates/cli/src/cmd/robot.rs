@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::Subcommand;
 use kappe_robot::{
-    Iso, Mat4, PathPoint, PlanOptions, PrintLayer, RobotSetup, UR10E, check_plan, plan_print,
-    urscript_programs, write_plan_json, write_trajectory_csv, write_urscript,
+    Iso, Mat4, PathPoint, Plan, PlanOptions, PrintLayer, RobotSetup, UR10E, check_plan, index_json,
+    lint, plan_print, program_files, resume_plan, write_plan_json, write_trajectory_csv,
 };
 use serde::Deserialize;
 
@@ -22,8 +22,9 @@ pub enum RobotCommand {
     /// speeds); exit code 1 when it fails.
     Check { plan: PathBuf },
     /// Plan a print path CSV (`layer,index,x,y,z,tx,ty,tz`, world frame) and write
-    /// DIR/plan.json, DIR/trajectory.csv and DIR/program.script (+ program_partNN.script when
-    /// split).
+    /// DIR/plan.json, DIR/trajectory.csv, the programs DIR/program_partNN.script (each ≤ the
+    /// target limit, linted), their index DIR/programs.json, and DIR/program.script when the
+    /// whole print fits in one program.
     Plan {
         path: PathBuf,
         /// Output directory (replaced atomically).
@@ -33,6 +34,64 @@ pub enum RobotCommand {
         #[arg(long)]
         config: Option<PathBuf>,
     },
+    /// Check URScript program files independently: syntax and blocks, known functions and
+    /// their argument counts, finite numbers, joint targets within the UR10e limits, I/O
+    /// numbers, and the motion target limit. Exit code 1 when any file fails.
+    Lint {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Most motion targets (move commands) per file.
+        #[arg(long, default_value_t = 1000)]
+        max_targets: usize,
+    },
+    /// Write the programs that continue a planned print from layer K (approach from the safe
+    /// pose, prime the pump, print on), from DIR/plan.json (written by `kappe design` or
+    /// `kappe robot plan`), checked and linted like the rest.
+    Resume {
+        /// Directory holding plan.json.
+        dir: PathBuf,
+        /// The first layer to print.
+        #[arg(long, allow_hyphen_values = true)]
+        from_layer: i64,
+        /// Output directory (default DIR/resume_from_layer_K; replaced atomically).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+/// The program files of a timed plan, each linted against the plan's target limit.
+pub fn linted_programs(plan: &Plan, prefix: &str) -> Result<Vec<kappe_robot::ProgramFile>> {
+    let files = program_files(plan, prefix)?;
+    let max = plan.options.program.max_moves_per_program;
+    for f in &files {
+        let rep = lint(&f.text, max);
+        if !rep.ok() {
+            bail!(
+                "{} fails the URScript check: {}",
+                f.name,
+                rep.problems.join("; ")
+            );
+        }
+    }
+    Ok(files)
+}
+
+/// Write a plan's outputs into `dir`: plan.json, trajectory.csv, the programs and their index.
+fn write_plan_outputs(dir: &Path, plan: &Plan, files: &[kappe_robot::ProgramFile]) -> Result<()> {
+    let mut csv = Vec::new();
+    write_trajectory_csv(plan, &mut csv)?;
+    let mut json = Vec::new();
+    write_plan_json(plan, &mut json)?;
+    write_file_atomic(&dir.join("trajectory.csv"), &csv)?;
+    write_file_atomic(&dir.join("plan.json"), &json)?;
+    for f in files {
+        write_file_atomic(&dir.join(&f.name), f.text.as_bytes())?;
+    }
+    write_file_atomic(&dir.join("programs.json"), index_json(files).as_bytes())?;
+    if let [one] = files {
+        write_file_atomic(&dir.join("program.script"), one.text.as_bytes())?;
+    }
+    Ok(())
 }
 
 #[derive(Deserialize)]
@@ -180,35 +239,93 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                 None => Config::default(),
             };
             let plan = plan_print(&layers, &cfg.setup, &cfg.options)?;
-            let mut script = Vec::new();
-            write_urscript(&plan, &mut script)?;
-            let mut csv = Vec::new();
-            write_trajectory_csv(&plan, &mut csv)?;
-            let mut json = Vec::new();
-            write_plan_json(&plan, &mut json)?;
-            let parts = urscript_programs(&plan)?;
-            write_dir_atomic(&out, |dir| {
-                write_file_atomic(&dir.join("program.script"), &script)?;
-                write_file_atomic(&dir.join("trajectory.csv"), &csv)?;
-                write_file_atomic(&dir.join("plan.json"), &json)?;
-                if parts.len() > 1 {
-                    for (i, p) in parts.iter().enumerate() {
-                        write_file_atomic(
-                            &dir.join(format!("program_part{:02}.script", i + 1)),
-                            p.as_bytes(),
-                        )?;
-                    }
-                }
-                Ok(())
-            })?;
+            let files = linted_programs(&plan, "program_part")?;
+            write_dir_atomic(&out, |dir| write_plan_outputs(dir, &plan, &files))?;
+            for s in &plan.slowdowns {
+                eprintln!(
+                    "note: station {} layer {} point {} to layer {} point {}: tool slowed to {:.1} % of the design speed ({}), the flow with it",
+                    s.station + 1,
+                    s.from.0,
+                    s.from.1,
+                    s.to.0,
+                    s.to.1,
+                    100.0 * s.min_speed_ratio,
+                    s.reason
+                );
+            }
             println!(
-                "planned {} waypoints in {} layers from {} station(s): joint motion {:.3} rad, print time {:.1} s, min clearance {:.4} m → {}",
+                "planned {} waypoints in {} layers from {} station(s): joint motion {:.3} rad, print time {:.1} s, total {:.1} s, min clearance {:.4} m, {} program(s) → {}",
                 plan.waypoint_count(),
                 layers.len(),
                 plan.stations.len(),
                 plan.joint_motion,
                 plan.print_time,
+                plan.total_time,
                 plan.min_clearance,
+                files.len(),
+                out.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        RobotCommand::Lint { files, max_targets } => {
+            let mut failed = 0;
+            for f in &files {
+                let text = read(f)?;
+                let rep = lint(&text, max_targets);
+                if rep.ok() {
+                    println!(
+                        "{}: OK ({} motion targets, {} calls)",
+                        f.display(),
+                        rep.targets,
+                        rep.calls
+                    );
+                } else {
+                    failed += 1;
+                    println!("{}: FAILED", f.display());
+                    for p in &rep.problems {
+                        println!("  {p}");
+                    }
+                }
+            }
+            if failed > 0 {
+                eprintln!("{failed} of {} file(s) failed", files.len());
+                Ok(ExitCode::FAILURE)
+            } else {
+                Ok(ExitCode::SUCCESS)
+            }
+        }
+        RobotCommand::Resume {
+            dir,
+            from_layer,
+            out,
+        } => {
+            let plan_path = dir.join("plan.json");
+            let plan: Plan = serde_json::from_str(&read(&plan_path)?)
+                .with_context(|| format!("{} is not a kappe plan JSON", plan_path.display()))?;
+            let rep = check_plan(&plan);
+            if !rep.problems.is_empty() {
+                bail!(
+                    "{} fails its check: {}",
+                    plan_path.display(),
+                    rep.problems.join("; ")
+                );
+            }
+            let resumed = resume_plan(&plan, from_layer)?;
+            let rep = check_plan(&resumed);
+            if !rep.problems.is_empty() {
+                bail!(
+                    "the resumed plan fails its check: {}",
+                    rep.problems.join("; ")
+                );
+            }
+            let files = linted_programs(&resumed, "resume_part")?;
+            let out = out.unwrap_or_else(|| dir.join(format!("resume_from_layer_{from_layer}")));
+            write_dir_atomic(&out, |d| write_plan_outputs(d, &resumed, &files))?;
+            println!(
+                "resume from layer {from_layer}: {} waypoints, {} program(s), {:.1} s → {}",
+                resumed.waypoint_count(),
+                files.len(),
+                resumed.total_time,
                 out.display()
             );
             Ok(ExitCode::SUCCESS)
