@@ -38,6 +38,8 @@ enum Command {
     Study(cmd::study::StudyCommand),
     /// Derive BLF_min (or the effective E) from printed prototypes that stood or failed.
     Calibrate(cmd::calibrate::CalibrateArgs),
+    /// Buildability of a test object (wall or cylinder): check every layer count with the green-state time model.
+    Buildability(cmd::buildability::BuildabilityArgs),
     /// The design loop: vary the free parameters within bounds to meet every constraint with the least material.
     Optimize(cmd::optimize::OptimizeArgs),
 }
@@ -58,6 +60,7 @@ fn main() -> ExitCode {
         Command::Study(c) => cmd::study::run(c),
         Command::Calibrate(a) => cmd::calibrate::run(a),
         Command::Optimize(a) => cmd::optimize::run(a),
+        Command::Buildability(a) => cmd::buildability::run(a),
     };
     match result {
         Ok(code) => code,

@@ -3,8 +3,8 @@
 //!
 //! Layer k (print index, 0 = first) prints from `start[k]` to `end[k]`; after it the printer
 //! pauses `wait[k]` (chosen) plus `relocation[k]` (a station change of the mobile robot before
-//! layer k + 1) plus the layer change itself, so `start[k+1] = end[k] + wait[k] + relocation[k]
-//! + change[k]`. A state is "n layers complete" and is checked at the moment layer n − 1 is
+//! layer k + 1) plus the layer change itself, so
+//! `start[k+1] = end[k] + wait[k] + relocation[k] + change[k]`. A state is "n layers complete" and is checked at the moment layer n − 1 is
 //! completed (its weakest moment: the load is all there and the top has age 0); the age of layer
 //! k there is `end[n−1] − end[k]`. A wait therefore adds to the age of every layer below it in
 //! every later state.

@@ -1,5 +1,6 @@
 //! One module per subcommand group.
 
+pub mod buildability;
 pub mod calibrate;
 pub mod cem;
 pub mod design;
