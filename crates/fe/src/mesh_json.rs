@@ -9,13 +9,19 @@
 //!   "load": {"type": "self_weight", "direction": [0, 0, -1]}
 //!        |  {"type": "nodal_forces", "forces": [[node, [fx, fy, fz]], [node, [fx, fy, fz, mx, my, mz]]]}
 //!        |  [ ...several of these... ],
-//!   "drilling_alpha": 1e-3,                // optional (CST+DKT only)
+//!   "drilling_alpha": 1e-3,                // optional (CST membranes only)
 //!   "element": "cst_dkt",                  // optional: "cst_dkt" (default) | "andes_dkt"
+//!                                          //   | "andes_dkmt" | "cst_dkmt" (Reissner–Mindlin)
 //!   "allow_mixed_orientation": false }     // optional
 //! ```
 //! Self-weight γ·t per unit area acts whenever γ > 0, along `direction` of a `self_weight`
 //! load (default −z); γ may also be given inside the `self_weight` load (as the fixtures do). Other keys (`name`, `units`, `description`, `geometry`, `note`) are
 //! ignored.
+//!
+//! Without `"element"` the mesh gets the fixtures' reference element CST+DKT (the
+//! `kappe fe` end-to-end tests compare with its exact reference factors); the
+//! shear-deformable `"andes_dkmt"` (issue 17: DKT in the thin limit, transverse shear for
+//! thick shells) is selected by name.
 
 use serde_json::Value;
 

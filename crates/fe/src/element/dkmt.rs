@@ -44,8 +44,8 @@
 //!   are those of the deflection, `∇w = γ − β`, not the rotations alone:
 //!   `K_G,w = ∫ (B_s − H_β)ᵀ N̂ (B_s − H_β) dA` (6-point degree-4 rule, exact), plus the
 //!   in-plane `u, v` terms as in [`super::cst_dkt`]. With `∇w ≈ −β` (DKT's choice) the
-//!   thick-plate factor would follow a different (non-Mindlin) closed form; the test
-//!   `thick::geometric_stiffness_needs_shear_slope` shows the difference.
+//!   thick-plate factor misses the Mindlin closed form (test
+//!   `mindlin::geometric_stiffness_needs_shear_slope`).
 //!
 //! The membrane is either Felippa's ANDES/OPT triangle with drilling freedoms
 //! ([`super::andes_dkt::AndesDkt::membrane_stiffness`], [`AndesDkmt`], the default element)
@@ -241,6 +241,19 @@ impl Dkmt {
         for &(xi, eta, w) in &GAUSS6 {
             let gw = self.b_shear(xi, eta) - self.h_beta(xi, eta);
             k += gw.transpose() * nh * gw * (w * self.area);
+        }
+        k
+    }
+}
+
+impl Dkmt {
+    /// The w-part of K_G with the slopes taken as the rotations alone (`∇w ≈ −β`, DKT's
+    /// choice), for comparison only: it ignores the shear part of the slope.
+    pub fn geometric_rotations_only(&self, nh: &Matrix2<f64>) -> Mat9 {
+        let mut k = Mat9::zeros();
+        for &(xi, eta, w) in &GAUSS6 {
+            let h = self.h_beta(xi, eta);
+            k += h.transpose() * nh * h * (w * self.area);
         }
         k
     }

@@ -172,6 +172,14 @@ fn mesh_json_element_field() {
     let parse = |extra: &str| kappe_fe::mesh_json::parse_mesh(&format!("{base}{extra}}}"));
     assert_eq!(parse("").unwrap().element, ElementKind::CstDkt);
     assert_eq!(
+        parse(r#", "element": "andes_dkmt""#).unwrap().element,
+        ElementKind::AndesDkmt
+    );
+    assert_eq!(
+        parse(r#", "element": "cst_dkmt""#).unwrap().element,
+        ElementKind::CstDkmt
+    );
+    assert_eq!(
         parse(r#", "element": "andes_dkt""#).unwrap().element,
         ElementKind::AndesDkt
     );

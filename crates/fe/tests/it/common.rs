@@ -10,10 +10,15 @@ pub fn fixture_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/fixtures/fe")
 }
 
+/// A fixture mesh with the fixtures' reference element CST+DKT, set explicitly so the
+/// Kirchhoff A-checks do not follow a change of the mesh-JSON default. Tests of other
+/// elements set `element` after loading.
 pub fn load_mesh(name: &str) -> ShellModel {
     let p = fixture_dir().join(format!("{name}.mesh.json"));
     let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
-    parse_mesh(&text).unwrap()
+    let mut m = parse_mesh(&text).unwrap();
+    m.element = kappe_fe::ElementKind::CstDkt;
+    m
 }
 
 pub fn load_json(file: &str) -> serde_json::Value {
