@@ -13,7 +13,9 @@
 //!   supports (e.g. the ~100 print states of a vault).
 //! * [`element::ShellElement`] is the element boundary; [`element::cst_dkt::CstDkt`] the
 //!   reference element (default), [`element::andes_dkt::AndesDkt`] the ANDES/OPT membrane with
-//!   drilling freedoms + DKT, chosen by [`ShellModel::element`] ([`ElementKind`]).
+//!   drilling freedoms + DKT, [`element::dkmt::AndesDkmt`] / [`element::dkmt::CstDkmt`] the
+//!   shear-deformable (Reissner–Mindlin, DKMT plate) variants for thick shells, chosen by
+//!   [`ShellModel::element`] ([`ElementKind`]).
 //! * [`mesh_json`] reads the fixture mesh format of `../shared/fixtures/fe/`.
 //!
 //! ```
