@@ -11,7 +11,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::output::write_file_atomic;
+use crate::output::{prepare_dir, write_file_atomic};
 
 #[derive(Args)]
 pub struct BuildabilityArgs {
@@ -26,6 +26,9 @@ pub struct BuildabilityArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Move a non-Kappe --out directory aside instead of refusing it.
+    #[arg(long)]
+    pub force: bool,
 }
 
 pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
@@ -33,6 +36,11 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
         .with_context(|| format!("cannot read the buildability spec {}", args.spec.display()))?;
     let resolved = kappe::buildability::BuildabilitySpec::from_toml_str(&text)
         .with_context(|| format!("invalid buildability spec {}", args.spec.display()))?;
+    // The output location is checked before any computing (nothing is written on bad input).
+    let prepared = match &args.out {
+        Some(out) => Some(prepare_dir(out, args.force, "kappe buildability")?),
+        None => None,
+    };
     let max = resolved.spec.object.max_layers;
     let bar = if args.quiet || args.json {
         ProgressBar::hidden()
@@ -59,14 +67,15 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
         "result": result,
     });
     let json = serde_json::to_string_pretty(&doc)? + "\n";
-    if let Some(out) = &args.out {
-        std::fs::create_dir_all(out)
-            .with_context(|| format!("cannot create the output directory {}", out.display()))?;
-        let n = result.states.len();
+    if let Some(prepared) = prepared {
+        let dir = prepared.path();
         let mut schedule = resolved.schedule.clone();
-        schedule.layers.truncate(n);
-        write_file_atomic(&out.join("buildability.json"), json.as_bytes())?;
-        write_file_atomic(&out.join("schedule.csv"), schedule.to_csv().as_bytes())?;
+        schedule.layers.truncate(result.states.len());
+        write_file_atomic(&dir.join("buildability.json"), json.as_bytes())?;
+        write_file_atomic(&dir.join("schedule.csv"), schedule.to_csv().as_bytes())?;
+        if let Some(notice) = prepared.commit()? {
+            eprintln!("note: {notice}");
+        }
     }
     if args.json {
         print!("{json}");
