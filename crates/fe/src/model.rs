@@ -91,18 +91,24 @@ pub struct ShellModel {
     pub element: ElementKind,
 }
 
-/// Which facet element [`crate::BucklingSolver::new`] uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Which facet element [`crate::BucklingSolver::new`] uses. Serialised by its
+/// [`ElementKind::name`] (`"cst_dkt"`, `"andes_dkt"`, `"andes_dkmt"`, `"cst_dkmt"`; the short
+/// names of [`ElementKind::from_name`] are accepted too), e.g. in a design file's `[analysis]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum ElementKind {
     /// CST membrane + DKT plate + drilling spring α·E·t·A ([`crate::element::cst_dkt::CstDkt`]);
     /// the element of `facet_ref_results.json` (A2).
     #[default]
+    #[serde(alias = "cst")]
     CstDkt,
     /// ANDES/OPT membrane with drilling freedoms + DKT plate
     /// ([`crate::element::andes_dkt::AndesDkt`]); `drilling_alpha` is not used.
+    #[serde(alias = "andes")]
     AndesDkt,
     /// ANDES/OPT membrane + DKMT Reissner–Mindlin plate (transverse shear, κ = 5/6;
     /// [`crate::element::dkmt::AndesDkmt`]); `drilling_alpha` is not used.
+    #[serde(alias = "dkmt", alias = "mindlin")]
     AndesDkmt,
     /// CST membrane + drilling spring + DKMT Reissner–Mindlin plate
     /// ([`crate::element::dkmt::CstDkmt`]).

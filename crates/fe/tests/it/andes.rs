@@ -282,3 +282,32 @@ fn andes_tension_with_consistent_loads_is_exact() {
         );
     }
 }
+
+/// `ElementKind` (de)serialises by its mesh-JSON name, short names accepted, unknown names
+/// rejected (design files name the element in `[analysis]`).
+#[test]
+fn element_kind_serde_names() {
+    for k in [
+        ElementKind::CstDkt,
+        ElementKind::AndesDkt,
+        ElementKind::AndesDkmt,
+        ElementKind::CstDkmt,
+    ] {
+        let s = serde_json::to_string(&k).unwrap();
+        assert_eq!(s, format!("\"{}\"", k.name()));
+        assert_eq!(serde_json::from_str::<ElementKind>(&s).unwrap(), k);
+    }
+    for (short, k) in [
+        ("cst", ElementKind::CstDkt),
+        ("andes", ElementKind::AndesDkt),
+        ("dkmt", ElementKind::AndesDkmt),
+        ("mindlin", ElementKind::AndesDkmt),
+    ] {
+        assert_eq!(
+            serde_json::from_str::<ElementKind>(&format!("\"{short}\"")).unwrap(),
+            k
+        );
+        assert_eq!(ElementKind::from_name(short), Some(k));
+    }
+    assert!(serde_json::from_str::<ElementKind>("\"mitc3\"").is_err());
+}
