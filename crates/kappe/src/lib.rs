@@ -12,6 +12,7 @@ pub mod buildability;
 pub mod calibrate;
 pub mod constraints;
 pub mod design_loop;
+pub mod ends;
 pub mod error;
 pub mod export;
 pub mod forces;

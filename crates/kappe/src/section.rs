@@ -12,8 +12,12 @@
 //! ```
 //!
 //! and K is the last m whose crown stays above the base plane, `Cr + T_m·e_z > 0`.
+//!
+//! With an end wall ([`EndKind::EndWall`], [`crate::ends`]) there are no start layers: K = 0 and
+//! `T_1 = −(lh / cos am)·e_y` is the wall face (the plane of layer −1) that layer 0 leans on.
 
 use crate::arch::Arch;
+use crate::ends::EndKind;
 use crate::error::DesignError;
 use crate::frame::{LayerFrame, V3};
 
@@ -67,8 +71,11 @@ pub struct Sections {
     pub n_centre: usize,
     /// Number of start layers K.
     pub n_start: usize,
-    /// `T_0 ..= T_{K+1}` (T_0 = 0); `T_{K+1}` continues the final-state thrust line below the base.
+    /// `T_0 ..= T_{K+1}` (T_0 = 0); `T_{K+1}` continues the final-state thrust line below the base
+    /// (with an end wall, K = 0 and `T_1` is the wall face).
     pub translations: Vec<V3>,
+    /// What layer 0 leans on.
+    pub end: EndKind,
     /// Every layer in print order: −K, …, −1, 0, …, N−1.
     pub layers: Vec<Layer>,
 }
@@ -81,7 +88,7 @@ impl Sections {
     }
 }
 
-/// Build the centre and start sections from the layer-0 arch.
+/// Build the centre and start sections from the layer-0 arch (a start-section end).
 pub fn build_sections(
     arch: &Arch,
     frame: &LayerFrame,
@@ -90,7 +97,38 @@ pub fn build_sections(
     phi: f64,
     half_chord_weight: impl Fn(f64) -> f64,
 ) -> Result<Sections, DesignError> {
+    build_sections_with_end(
+        arch,
+        frame,
+        length,
+        layer_height,
+        phi,
+        half_chord_weight,
+        EndKind::StartSection,
+    )
+}
+
+/// Build the sections for the given end: the start section of method.md §6, or none against an
+/// end wall.
+pub fn build_sections_with_end(
+    arch: &Arch,
+    frame: &LayerFrame,
+    length: f64,
+    layer_height: f64,
+    phi: f64,
+    half_chord_weight: impl Fn(f64) -> f64,
+    end: EndKind,
+) -> Result<Sections, DesignError> {
     let n_centre = ((length * frame.tilt.cos() / layer_height).round() as usize).max(1);
+    if end == EndKind::EndWall {
+        return Ok(Sections {
+            n_centre,
+            n_start: 0,
+            translations: vec![V3::zeros(), -frame.layer_step(layer_height)],
+            end,
+            layers: centre_layers(arch, frame, layer_height, n_centre),
+        });
+    }
     let crown_z = arch
         .points
         .iter()
@@ -138,7 +176,25 @@ pub fn build_sections(
             &half_chord_weight,
         )?);
     }
+    layers.extend(centre_layers(arch, frame, layer_height, n_centre));
+    Ok(Sections {
+        n_centre,
+        n_start,
+        translations,
+        end,
+        layers,
+    })
+}
+
+/// Centre layers 0..N−1: layer 0 translated by `k·(lh / cos am)·e_y`.
+fn centre_layers(
+    arch: &Arch,
+    frame: &LayerFrame,
+    layer_height: f64,
+    n_centre: usize,
+) -> Vec<Layer> {
     let step = frame.layer_step(layer_height);
+    let mut layers = Vec::with_capacity(n_centre);
     for k in 0..n_centre {
         let offset = step * k as f64;
         let nodes = arch
@@ -162,12 +218,7 @@ pub fn build_sections(
             segment_forces: arch.segment_forces.clone(),
         });
     }
-    Ok(Sections {
-        n_centre,
-        n_start,
-        translations,
-        layers,
-    })
+    layers
 }
 
 /// Layer 0 translated by `t` and trimmed by z = 0: the interior nodes above the base are kept and

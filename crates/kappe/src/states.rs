@@ -11,7 +11,10 @@
 //! so the column force stays along the trail edge to the next layer; then
 //! `r ← r + e_z + d_m (tan(am) e_y − e_z)`. Centre layers have d = 1 (r grows by tan(am) e_y), the
 //! last start layer −K is free and takes d = φ; its column edges run along r to the base plane.
+//! Against an end wall there are no start layers; every column ends with the horizontal bed joint
+//! from layer 0 to the wall face ([`crate::ends`]).
 
+use crate::ends::EndKind;
 use crate::error::DesignError;
 use crate::frame::{LayerFrame, V3};
 use crate::section::{NodeKind, Sections};
@@ -23,7 +26,8 @@ pub enum Role {
     Column,
     /// A layer foot on the base plane: a reaction node (support without trail edge).
     Foot,
-    /// The end of a column on the base plane: the support of that trail.
+    /// The end of a column: the support of that trail, on the base plane (start section) or on
+    /// the end-wall face (end wall, `crate::ends`).
     ColumnEnd,
 }
 
@@ -202,6 +206,32 @@ pub fn build_state(
         };
         let x = nodes[last].xyz;
         let id = sections.layers[q].id;
+        if sections.end == EndKind::EndWall {
+            // The wall face is the plane of layer −1: the last bed joint is the horizontal step
+            // back from layer 0 (see `crate::ends`).
+            if id != 0 {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!(
+                        "column {i} ends in layer {id}, not on layer 0 at the end wall"
+                    ),
+                });
+            }
+            let end = x + sections
+                .translations
+                .get(1)
+                .copied()
+                .unwrap_or_else(V3::zeros);
+            col.push(nodes.len());
+            nodes.push(NetNode {
+                xyz: end,
+                load: V3::zeros(),
+                layer: id,
+                role: Role::ColumnEnd,
+            });
+            trails.push(col.clone());
+            continue;
+        }
         let dir = if id >= 0 {
             return Err(DesignError::State {
                 state: top,
