@@ -15,8 +15,9 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use crate::input::{
-    BedJoint, Bound, ConstraintRow, Layer, Parameter, PrintPath, PrintState, ReportInput,
-    RobotAnimation, Vec3,
+    BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, PrintPath,
+    PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Station, Timeline, Vec3,
+    WorstPlace,
 };
 
 const SPAN: f64 = 0.8;
@@ -334,7 +335,11 @@ pub fn demo_input() -> ReportInput {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
             (a.min(y), b.max(y))
         });
-    let base = [0.0, 0.5 * (y_min + y_max) + 0.6, 0.45];
+    // Two stations (the second 0.1 m further along +y for the second half of the path), so the
+    // page shows a station change; the nozzle tip follows every path point.
+    let base0 = [0.0, 0.5 * (y_min + y_max) + 0.6, 0.45];
+    let base1 = add(base0, [0.0, 0.1, 0.0]);
+    let switch = print_path.points.len() / 2;
     let speed = 0.05; // m/s along the path
     let mut robot = RobotAnimation {
         times: Vec::new(),
@@ -347,19 +352,30 @@ pub fn demo_input() -> ReportInput {
     // Converge on the first path point before recording, so the animation starts settled.
     if let Some(p0) = print_path.points.first() {
         for _ in 0..10 {
-            q = ik_position(base, *p0, q);
+            q = ik_position(base0, *p0, q);
         }
     }
     let mut t = 0.0;
     let mut last: Option<Vec3> = None;
+    let mut point_time = Vec::with_capacity(print_path.points.len());
+    let mut layer_of_last = None;
     for (i, p) in print_path.points.iter().enumerate() {
+        let layer = print_path.layer.get(i).copied();
         if let Some(l) = last {
             t += norm(sub(*p, l)) / speed;
+            // 4 s between layers (travel and settle), 20 s for the station change.
+            if layer != layer_of_last {
+                t += if i == switch { 20.0 } else { 4.0 };
+            }
         }
         last = Some(*p);
-        // Every second path point is enough for a smooth animation and keeps the page small.
-        if i % 2 == 1 {
-            continue;
+        layer_of_last = layer;
+        point_time.push(t);
+        let (station, base) = if i < switch { (0, base0) } else { (1, base1) };
+        if i == switch {
+            for _ in 0..10 {
+                q = ik_position(base, *p, q);
+            }
         }
         q = ik_position(base, *p, q);
         let qq = joints(q);
@@ -369,12 +385,142 @@ pub fn demo_input() -> ReportInput {
         robot.times.push(t);
         robot.joints.push(qq);
         robot.poses.push(pose);
+        robot.station.push(station);
     }
-    // Pedestal as an extra capsule from the floor to the robot base.
-    robot.link_radii.push(0.09);
-    for pose in &mut robot.poses {
-        pose.push([[base[0], base[1], 0.0], base]);
-    }
+    // The capsule poses are only the fallback when there is no cell; the cell draws the meshes.
+    robot.poses.clear();
+    let translation = |b: Vec3| {
+        [
+            [1.0, 0.0, 0.0, b[0]],
+            [0.0, 1.0, 0.0, b[1]],
+            [0.0, 0.0, 1.0, b[2]],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    };
+    let ids: Vec<i32> = layers.iter().map(|l| l.id).collect();
+    let split_layer = print_path.layer.get(switch).copied().unwrap_or(0);
+    let split = ids.iter().position(|&id| id == split_layer).unwrap_or(0);
+    let floor = -0.3;
+    let cell = Cell {
+        stations: vec![
+            Station {
+                world_from_base: translation(base0),
+                layers: ids.get(..split).unwrap_or(&[]).to_vec(),
+            },
+            Station {
+                world_from_base: translation(base1),
+                layers: ids.get(split..).unwrap_or(&[]).to_vec(),
+            },
+        ],
+        flange_from_tcp: translation([0.0, 0.0, NOZZLE]),
+        tool: vec![Capsule {
+            a: [0.0, 0.0, 0.01],
+            b: [0.0, 0.0, NOZZLE - 0.03],
+            radius: 0.03,
+        }],
+        mobile_base: vec![BoxBody {
+            name: "pedestal".into(),
+            center: [0.0, 0.0, 0.5 * (floor - base0[2])],
+            half_extents: [0.15, 0.15, 0.5 * (base0[2] - floor)],
+            yaw: 0.0,
+        }],
+        obstacles: [-1.0, 1.0]
+            .iter()
+            .map(|sx: &f64| BoxBody {
+                name: if *sx < 0.0 { "beam_left" } else { "beam_right" }.into(),
+                center: [sx * (SPAN / 2.0 + 0.05), 0.5 * (y_min + y_max), floor / 2.0],
+                half_extents: [0.05, 0.5 * (y_max - y_min) + 0.1, -floor / 2.0],
+                yaw: 0.0,
+            })
+            .collect(),
+        floor_z: Some(floor),
+    };
+    let total_time = t;
+
+    // Mode shapes: a bulge of the top layers along the layer normal, half a sine over each
+    // layer, decaying downward (synthetic).
+    let modes: Vec<ModeShape> = states
+        .iter()
+        .enumerate()
+        .filter(|(_, st)| st.layers_printed >= 2)
+        .map(|(si, st)| {
+            let top = st.layers_printed - 1;
+            let displacement = layers
+                .iter()
+                .take(st.layers_printed)
+                .enumerate()
+                .flat_map(|(k, l)| {
+                    let decay = (-((top - k) as f64) / 3.0).exp();
+                    let m = l.nodes.len().max(2) - 1;
+                    (0..l.nodes.len())
+                        .map(move |j| scale(n, decay * (PI * j as f64 / m as f64).sin()))
+                })
+                .collect();
+            ModeShape {
+                state: si,
+                blf: st.blf.unwrap_or(0.0),
+                displacement,
+            }
+        })
+        .collect();
+
+    // Layer age: time since the layer was finished, per state (the state ends with its top layer).
+    let layer_end: Vec<f64> = ids
+        .iter()
+        .map(|id| {
+            print_path
+                .layer
+                .iter()
+                .zip(&point_time)
+                .filter(|(l, _)| *l == id)
+                .map(|(_, t)| *t)
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let age = Quantity {
+        key: "layer_age".into(),
+        label: "layer age".into(),
+        unit: "min".into(),
+        to_unit: 1.0 / 60.0,
+        per: QuantityPer::Layer,
+        diverging: false,
+        states: states
+            .iter()
+            .map(|st| {
+                let now = layer_end.get(st.layers_printed - 1).copied().unwrap_or(0.0);
+                layer_end
+                    .iter()
+                    .take(st.layers_printed)
+                    .map(|e| now - e)
+                    .collect()
+            })
+            .collect(),
+        note: Some("time since the layer was finished (synthetic)".into()),
+    };
+    let crown = |k: usize| {
+        layers.get(k).map_or([0.0; 3], |l| {
+            l.nodes.get(l.nodes.len() / 2).copied().unwrap_or([0.0; 3])
+        })
+    };
+    let worst_places = vec![
+        WorstPlace {
+            constraint: "sigma_min".into(),
+            state: worst_min_state,
+            layer: layers.first().map(|l| l.id),
+            position: layers
+                .first()
+                .and_then(|l| l.nodes.first().copied())
+                .unwrap_or([0.0; 3]),
+            signed_value: None,
+        },
+        WorstPlace {
+            constraint: "blf".into(),
+            state: Some(total - 1),
+            layer: layers.last().map(|l| l.id),
+            position: crown(total - 1),
+            signed_value: None,
+        },
+    ];
 
     let parameters = vec![
         Parameter {
@@ -486,6 +632,13 @@ pub fn demo_input() -> ReportInput {
         constraints,
         robot: Some(robot),
         plots: Vec::new(),
-        ..ReportInput::default()
+        timeline: Some(Timeline {
+            point_time,
+            total_time,
+        }),
+        cell: Some(cell),
+        modes,
+        worst_places,
+        quantities: vec![age],
     }
 }

@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 
 use crate::error::ReportError;
 use crate::input::ReportInput;
-use crate::plots::{PlotSpec, fmt_num, render_svg, standard_plots};
+use crate::plots::{PlotSpec, fmt_num, render_plot, standard_plots};
 
 /// The vendored three.js bundle (three 0.187.0 + OrbitControls, MIT; see `assets/three-LICENSE.txt`).
 pub const THREE_BUNDLE: &str = include_str!("../assets/three-vendor.min.js");
@@ -89,7 +89,8 @@ fn compact_numbers(v: &mut serde_json::Value) {
     }
 }
 
-/// Serialises the scene island: the [`ReportInput`] as JSON, floats rounded to
+/// Serialises the scene island: the [`ReportInput`] in the compact form of `island.rs` (long
+/// arrays as base64 typed arrays), the remaining floats rounded to
 /// [`ISLAND_SIGNIFICANT_DIGITS`]. Every `<` is written as `\u003c` (valid JSON, same string), so
 /// neither `</script` nor `<!--` can appear and end or confuse the `<script>` element; `<` can
 /// only occur inside JSON strings.
@@ -97,9 +98,41 @@ fn compact_numbers(v: &mut serde_json::Value) {
 /// # Errors
 /// [`ReportError::Json`] if serialisation fails.
 pub fn scene_json(input: &ReportInput) -> Result<String, ReportError> {
-    let mut value = serde_json::to_value(input)?;
+    let mut value = crate::island::island(input);
     compact_numbers(&mut value);
     Ok(serde_json::to_string(&value)?.replace('<', "\\u003c"))
+}
+
+/// The UR10e meshes and kinematic chain (`assets/ur10e-meshes.json`, BSD-3-Clause, see
+/// `assets/ur10e-LICENSE.txt`), inlined when the input has a robot cell.
+pub const UR10E_MESHES: &str = include_str!("../assets/ur10e-meshes.json");
+/// The licence of [`UR10E_MESHES`].
+pub const UR10E_LICENSE: &str = include_str!("../assets/ur10e-LICENSE.txt");
+
+/// A constraint's worst value as the table shows it: a stress whose magnitude is below 1e-9 of
+/// the largest stress limit (round-off of the force pass, method.md §9) reads 0; a magnitude row
+/// shows the signed value of its worst place when the input gives one.
+fn worst_text(input: &ReportInput, c: &crate::input::ConstraintRow) -> String {
+    let signed = input
+        .worst_places
+        .iter()
+        .find(|w| w.constraint == c.name)
+        .and_then(|w| w.signed_value);
+    let v = signed.unwrap_or(c.worst);
+    let stress_scale = input
+        .constraints
+        .iter()
+        .filter(|r| r.unit == c.unit)
+        .map(|r| {
+            r.limit
+                .abs()
+                .max(r.worst.abs().min(r.limit.abs().max(1.0) * 1e3))
+        })
+        .fold(0.0, f64::max);
+    if c.unit.ends_with("Pa") && v != 0.0 && v.abs() <= 1e-9 * stress_scale.max(1.0) {
+        return "0 (round-off)".into();
+    }
+    fmt_num(v)
 }
 
 /// Renders the complete report page.
@@ -112,11 +145,11 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
     let mut specs = standard_plots(input);
     specs.extend(input.plots.iter().map(|p| PlotSpec {
         plot: p.clone(),
-        reference_lines: Vec::new(),
+        ..PlotSpec::default()
     }));
-    let svgs = specs
+    let plots = specs
         .iter()
-        .map(|s| render_svg(s).map(|svg| (s.plot.title.clone(), svg)))
+        .map(|s| render_plot(s).map(|r| (s, r)))
         .collect::<Result<Vec<_>, _>>()?;
 
     let name = escape_html(&input.name);
@@ -130,10 +163,9 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
             format!("FAIL: {failed} of {total} constraints violated"),
         )
     };
-    let last = input.states.len().saturating_sub(1);
 
     // `write!` into a String cannot fail; the results are ignored on purpose.
-    let mut h = String::with_capacity(THREE_BUNDLE.len() + json.len() + 64 * 1024);
+    let mut h = String::with_capacity(THREE_BUNDLE.len() + json.len() + 128 * 1024);
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -145,87 +177,59 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
         css = REPORT_CSS,
     );
 
-    // 3D viewer and its controls.
+    // 3D viewer, its overlays and the one timeline.
     let _ = write!(
         h,
-        "<section id=\"viewer-section\">\n<h2>Cap, print path and robot</h2>\n\
+        "<section id=\"viewer-section\">\n<h2>Cap, print and robot</h2>\n\
          <div id=\"viewer\"><canvas id=\"kappe-canvas\" aria-label=\"3D view of the cap\"></canvas>\
          <div id=\"viewer-message\"><noscript>The 3D view needs JavaScript.</noscript></div>\
-         <div id=\"legend\">normal stress (blue: compression, red: tension)<div id=\"legend-bar\"></div>\
-         <div class=\"ends\"><span id=\"legend-min\"></span><span>0</span><span id=\"legend-max\"></span></div></div></div>\n\
-         <div class=\"controls\"><label for=\"state-slider\">Print state</label>\
-         <input type=\"range\" id=\"state-slider\" min=\"0\" max=\"{last}\" step=\"1\" value=\"{last}\">\
-         <output id=\"state-label\" for=\"state-slider\"></output></div>\n\
-         <div class=\"controls\" id=\"robot-controls\"><button id=\"robot-play\" type=\"button\">▶ Play robot</button>\
-         <input type=\"range\" id=\"robot-time\" min=\"0\" max=\"0\" step=\"1\" value=\"0\" aria-label=\"robot time step\">\
-         <output id=\"robot-label\"></output></div>\n\
+         <div id=\"toolbar\" class=\"overlay\">\
+         <button type=\"button\" data-view=\"iso\">Iso</button><button type=\"button\" data-view=\"top\">Top</button>\
+         <button type=\"button\" data-view=\"front\">Front</button><button type=\"button\" data-view=\"side\">Side</button>\
+         <button type=\"button\" id=\"fit\">Fit</button>\
+         <label><input type=\"checkbox\" id=\"follow\"> follow nozzle</label></div>\
+         <div id=\"legend\" class=\"overlay\"><label for=\"colour-by\">colour</label> <select id=\"colour-by\"></select>\
+         <div id=\"legend-scale\"></div><p id=\"legend-note\"></p></div>\
+         <div id=\"scalebar\" class=\"overlay\"><div id=\"scalebar-bar\"></div><span id=\"scalebar-label\"></span></div>\
+         <div id=\"mode-badge\" class=\"overlay\" hidden></div></div>\n\
+         <div class=\"controls timeline\"><button id=\"play\" type=\"button\">▶ Play</button>\
+         <input type=\"range\" id=\"timeline\" min=\"0\" max=\"10000\" step=\"1\" value=\"10000\" aria-label=\"print timeline\">\
+         <output id=\"time-label\" for=\"timeline\"></output></div>\n\
          <div class=\"controls\">\
+         <label><input type=\"checkbox\" id=\"show-mode\"> buckling mode</label>\
+         <label>scale <input type=\"range\" id=\"mode-scale\" min=\"1\" max=\"100\" value=\"30\" aria-label=\"mode shape scale\"></label>\
+         <label><input type=\"checkbox\" id=\"show-markers\" checked> worst places</label>\
          <label><input type=\"checkbox\" id=\"show-beads\" checked> beads</label>\
-         <label><input type=\"checkbox\" id=\"show-top\" checked> top layer path + tool axes</label>\
-         <label><input type=\"checkbox\" id=\"show-path\"> whole print path</label>\
+         <label><input type=\"checkbox\" id=\"show-top\" checked> current layer path</label>\
          <label><input type=\"checkbox\" id=\"show-joints\"> bed joints</label>\
-         <label><input type=\"checkbox\" id=\"show-robot\" checked> robot</label></div>\n</section>\n",
+         <label><input type=\"checkbox\" id=\"show-robot\" checked> robot</label>\
+         <label><input type=\"checkbox\" id=\"show-cell\" checked> cell</label></div>\n</section>\n",
     );
 
-    // State panel (filled for the last state; the viewer updates it on slider input).
+    // State panel (the viewer fills it for the current moment).
     let _ = write!(
         h,
-        "<aside id=\"state-panel\">\n<h2>Print state</h2>\n<dl class=\"state\">"
+        "<aside id=\"state-panel\">\n<h2>At this moment</h2>\n<dl class=\"state\">"
     );
-    if let Some(st) = input.states.last() {
-        let top = input
-            .layers
-            .get(st.layers_printed.saturating_sub(1))
-            .map_or_else(|| "–".to_string(), |l| l.id.to_string());
-        let blf = st
-            .blf
-            .map_or_else(|| "not computed".into(), |b| format!("{b:.2}"));
-        let rows = [
-            (
-                "st-index",
-                "state",
-                format!("{} ({} of {})", st.index, last + 1, last + 1),
-            ),
-            (
-                "st-progress",
-                "progress",
-                format!("{:.1} %", st.progress * 100.0),
-            ),
-            (
-                "st-layers",
-                "layers printed",
-                format!("{} of {}", st.layers_printed, input.layers.len()),
-            ),
-            ("st-top", "top layer", top),
-            ("st-blf", "BLF", blf),
-            ("st-smin", "σ_min", format!("{:.2} kPa", st.sigma_min / 1e3)),
-            ("st-smax", "σ_max", format!("{:.2} kPa", st.sigma_max / 1e3)),
-            (
-                "st-overhang",
-                "max overhang",
-                format!("{:.2} mm", st.max_overhang * 1e3),
-            ),
-        ];
-        for (id, label, value) in rows {
-            let _ = write!(
-                h,
-                "<dt>{label}</dt><dd id=\"{id}\">{}</dd>",
-                escape_html(&value)
-            );
-        }
-        let (class, text) = if st.ok {
-            ("pass", "pass")
-        } else {
-            ("fail", "FAIL")
-        };
-        let _ = write!(
-            h,
-            "<dt>constraints</dt><dd id=\"st-ok\" class=\"{class}\">{text}</dd>"
-        );
+    let rows = [
+        ("st-time", "time"),
+        ("st-layers", "layers shown"),
+        ("st-station", "robot station"),
+        ("st-index", "print state"),
+        ("st-progress", "progress"),
+        ("st-top", "top complete layer"),
+        ("st-blf", "BLF (this state)"),
+        ("st-smin", "σ_min (this state)"),
+        ("st-smax", "σ_max (this state)"),
+        ("st-overhang", "max |overhang| so far"),
+    ];
+    for (id, label) in rows {
+        let _ = write!(h, "<dt>{label}</dt><dd id=\"{id}\">–</dd>");
     }
     let _ = write!(
         h,
-        "</dl>\n<h2>Parameters</h2>\n<table id=\"parameters\"><thead><tr><th>parameter</th><th>value</th><th>unit</th></tr></thead><tbody>"
+        "<dt>constraints</dt><dd id=\"st-ok\">–</dd></dl>\n<h2>Parameters</h2>\n\
+         <table id=\"parameters\"><thead><tr><th>parameter</th><th>value</th><th>unit</th></tr></thead><tbody>"
     );
     for p in &input.parameters {
         let _ = write!(
@@ -238,57 +242,87 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
     }
     let _ = write!(h, "</tbody></table>\n</aside>\n");
 
-    // Constraint table.
+    // Constraint table; a row with a worst place is a link to it in 3D.
     let _ = write!(
         h,
-        "<section id=\"constraints\" class=\"wide\">\n<h2>Constraints</h2>\n<table><thead><tr>\
-         <th>constraint</th><th>limit</th><th>worst value</th><th>unit</th><th>state</th><th>element</th><th>result</th>\
+        "<section id=\"constraints\" class=\"wide\">\n<h2>Constraints</h2>\n\
+         <p class=\"hint\">Click a row to go to its worst place in the 3D view.</p><table><thead><tr>\
+         <th>constraint</th><th>limit</th><th>worst value</th><th>unit</th><th>state</th><th>where</th><th>result</th>\
          </tr></thead><tbody>"
     );
-    for c in &input.constraints {
+    for (ci, c) in input.constraints.iter().enumerate() {
         let rel = c.bound.symbol();
+        let place = input.worst_places.iter().any(|w| w.constraint == c.name);
         let _ = write!(
             h,
-            "<tr class=\"{cls}\"><td>{name}</td><td class=\"num\">{rel} {limit}</td><td class=\"num\">{worst}</td>\
-             <td>{unit}</td><td class=\"num\">{state}</td><td>{element}</td><td>{result}</td></tr>",
+            "<tr class=\"{cls}{link}\" data-row=\"{ci}\" data-constraint=\"{name}\"{tab}><td>{name}</td><td class=\"num\">{rel} {limit}</td><td class=\"num\">{worst}</td>\
+             <td>{unit}</td><td class=\"num\">{state}</td><td>{element}</td><td class=\"result {rcls}\">{result}</td></tr>",
             cls = if c.pass { "pass-row" } else { "fail" },
+            link = if place { " link" } else { "" },
+            tab = if place { " tabindex=\"0\"" } else { "" },
             name = escape_html(&c.name),
             limit = fmt_num(c.limit),
-            worst = fmt_num(c.worst),
+            worst = escape_html(&worst_text(input, c)),
             unit = escape_html(&c.unit),
             state = c.state.map_or_else(|| "–".to_string(), |s| s.to_string()),
             element = escape_html(c.element.as_deref().unwrap_or("–")),
+            rcls = if c.pass { "pass" } else { "fail" },
             result = if c.pass { "pass" } else { "FAIL" },
         );
     }
     let _ = write!(h, "</tbody></table>\n</section>\n");
 
-    // Plots.
+    // Plots, each with the data needed to draw the cursor of the current moment.
     let _ = write!(
         h,
         "<section id=\"plots\" class=\"wide\">\n<h2>Plots</h2>\n<div class=\"grid\">\n"
     );
-    for (title, svg) in &svgs {
+    for (spec, r) in &plots {
+        let f = &r.frame;
         let _ = writeln!(
             h,
-            "<figure aria-label=\"{}\">{}</figure>",
-            escape_html(title),
-            strip_xml_declaration(svg)
+            "<figure aria-label=\"{}\" data-cursor=\"{}\" data-x0=\"{}\" data-x1=\"{}\" data-px0=\"{}\" data-px1=\"{}\" data-py0=\"{}\" data-py1=\"{}\">{}</figure>",
+            escape_html(&spec.plot.title),
+            spec.cursor.as_str(),
+            f.x0,
+            f.x1,
+            f.px0,
+            f.px1,
+            f.py0,
+            f.py1,
+            strip_xml_declaration(&r.svg)
         );
     }
     let _ = write!(h, "</div>\n</section>\n</main>\n");
+    let robot_meshes = input.cell.is_some() && input.robot.is_some();
     let _ = writeln!(
         h,
-        "<footer>Generated by kappe-report {}. 3D view: three.js r{} (MIT licence, included in this file).</footer>",
+        "<footer>Generated by kappe-report {}. 3D view: three.js r{} (MIT licence, included in this file){}.</footer>",
         env!("CARGO_PKG_VERSION"),
-        crate::THREE_REVISION
+        crate::THREE_REVISION,
+        if robot_meshes {
+            "; UR10e meshes from ROS ur_description (BSD-3-Clause, licence included in this file)"
+        } else {
+            ""
+        }
     );
 
     // Data, then the libraries: the viewer runs synchronously at the end of the body.
+    let _ = writeln!(
+        h,
+        "<script type=\"application/json\" id=\"kappe-data\">{json}</script>"
+    );
+    if robot_meshes {
+        let _ = write!(
+            h,
+            "<!-- UR10e meshes: {} -->\n<script type=\"application/json\" id=\"kappe-robot\">{}</script>\n",
+            UR10E_LICENSE.replace("--", "- -").replace('>', ")"),
+            UR10E_MESHES.trim().replace('<', "\\u003c"),
+        );
+    }
     let _ = write!(
         h,
-        "<script type=\"application/json\" id=\"kappe-data\">{json}</script>\n\
-         <script>\n/*\nthree.js licence:\n{licence}*/\n{three}\n</script>\n<script>\n{viewer}\n</script>\n</body>\n</html>\n",
+        "<script>\n/*\nthree.js licence:\n{licence}*/\n{three}\n</script>\n<script>\n{viewer}\n</script>\n</body>\n</html>\n",
         licence = escape_inline_script(&THREE_LICENSE.replace("*/", "* /")),
         three = escape_inline_script(THREE_BUNDLE),
         viewer = escape_inline_script(VIEWER_JS),

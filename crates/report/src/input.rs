@@ -333,7 +333,7 @@ pub struct RobotAnimation {
 }
 
 /// A line plot rendered as inline SVG.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 pub struct Plot {
     /// Title above the plot.
     pub title: String,

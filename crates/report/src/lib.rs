@@ -39,21 +39,25 @@ mod demo;
 mod error;
 mod html;
 mod input;
+mod island;
 mod plots;
 mod study;
 
 pub use demo::demo_input;
 pub use error::ReportError;
 pub use html::{
-    ISLAND_SIGNIFICANT_DIGITS, REPORT_CSS, THREE_BUNDLE, THREE_LICENSE, VIEWER_JS, escape_html,
-    escape_inline_script, render_html, scene_json,
+    ISLAND_SIGNIFICANT_DIGITS, REPORT_CSS, THREE_BUNDLE, THREE_LICENSE, UR10E_LICENSE,
+    UR10E_MESHES, VIEWER_JS, escape_html, escape_inline_script, render_html, scene_json,
 };
 pub use input::{
     BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, Plot,
     PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Series, Station,
     Timeline, Vec3, WorstPlace,
 };
-pub use plots::{PLOT_SIZE, PlotSpec, ReferenceLine, fmt_num, render_svg, standard_plots};
+pub use plots::{
+    CursorAxis, PLOT_SIZE, PlotFrame, PlotSpec, ReferenceLine, RenderedPlot, VerticalMarker,
+    fmt_num, render_plot, render_svg, standard_plots,
+};
 pub use study::{StudyCell, StudyColumn, StudyRow, StudyTable, render_study_html};
 
 /// The three.js revision of the vendored bundle (`THREE.REVISION`).

@@ -8,6 +8,7 @@
 //! over time. Limits from the constraint table are drawn as dashed reference lines.
 
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use serde::{Deserialize, Serialize};
 
 use crate::error::ReportError;
@@ -25,13 +26,83 @@ pub struct ReferenceLine {
     pub y: f64,
 }
 
+/// A vertical marker, e.g. a robot station change.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VerticalMarker {
+    /// Legend name, e.g. `station 2`.
+    pub name: String,
+    /// Position in plot x units.
+    pub x: f64,
+}
+
+/// What the x axis of a plot follows, so the page can draw the cursor of the current moment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CursorAxis {
+    /// No cursor.
+    #[default]
+    None,
+    /// Print progress in percent.
+    Progress,
+    /// Robot time in seconds.
+    Time,
+    /// Layer id.
+    Layer,
+}
+
+impl CursorAxis {
+    /// The name the page uses (`data-cursor`).
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CursorAxis::None => "none",
+            CursorAxis::Progress => "progress",
+            CursorAxis::Time => "time",
+            CursorAxis::Layer => "layer",
+        }
+    }
+}
+
 /// A plot with its reference lines, ready to draw.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct PlotSpec {
     /// The data.
     pub plot: Plot,
     /// Dashed horizontal lines.
     pub reference_lines: Vec<ReferenceLine>,
+    /// Dotted vertical lines (station changes).
+    pub markers: Vec<VerticalMarker>,
+    /// Logarithmic y axis (the BLF, whose governing values are small beside its early values).
+    pub log_y: bool,
+    /// What the cursor follows.
+    pub cursor: CursorAxis,
+}
+
+/// Where the data lie in the SVG: data x range and its pixel range, and the pixel y range of
+/// the plotting area (for the page's cursor).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlotFrame {
+    /// Data x at the left edge of the plotting area.
+    pub x0: f64,
+    /// Data x at the right edge.
+    pub x1: f64,
+    /// Pixel x of the left edge.
+    pub px0: i32,
+    /// Pixel x of the right edge.
+    pub px1: i32,
+    /// Pixel y of the top edge.
+    pub py0: i32,
+    /// Pixel y of the bottom edge.
+    pub py1: i32,
+}
+
+/// A drawn plot.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RenderedPlot {
+    /// The SVG document.
+    pub svg: String,
+    /// Where the data lie in it.
+    pub frame: PlotFrame,
 }
 
 /// Limit of the first constraint whose name contains `key` (case-insensitive), scaled.
@@ -74,6 +145,9 @@ pub fn standard_plots(input: &ReportInput) -> Vec<PlotSpec> {
                 }],
             },
             reference_lines,
+            markers: station_markers_progress(input),
+            log_y: true,
+            cursor: CursorAxis::Progress,
         });
     }
 
@@ -123,6 +197,9 @@ pub fn standard_plots(input: &ReportInput) -> Vec<PlotSpec> {
             .iter()
             .filter_map(|k| unit_to_kpa(k))
             .collect(),
+        markers: station_markers_progress(input),
+        log_y: false,
+        cursor: CursorAxis::Progress,
     });
 
     let overhang: Vec<[f64; 2]> = input
@@ -164,6 +241,8 @@ pub fn standard_plots(input: &ReportInput) -> Vec<PlotSpec> {
                 }],
             },
             reference_lines,
+            cursor: CursorAxis::Layer,
+            ..PlotSpec::default()
         });
     }
 
@@ -188,8 +267,90 @@ pub fn standard_plots(input: &ReportInput) -> Vec<PlotSpec> {
                 y_label: "joint angle [deg]".into(),
                 series,
             },
-            reference_lines: Vec::new(),
+            markers: station_markers_time(input),
+            cursor: CursorAxis::Time,
+            ..PlotSpec::default()
         });
+    }
+    // Every extra colour quantity (layer age, stiffness, …): its range over the printed
+    // elements of each state.
+    for q in &input.quantities {
+        if q.states.len() != input.states.len() || input.states.len() < 2 {
+            continue;
+        }
+        let (mut lo, mut hi) = (Vec::new(), Vec::new());
+        for (s, values) in input.states.iter().zip(&q.states) {
+            let (a, b) = values
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                });
+            if a.is_finite() {
+                lo.push([pct(s.progress), a * q.to_unit]);
+                hi.push([pct(s.progress), b * q.to_unit]);
+            }
+        }
+        out.push(PlotSpec {
+            plot: Plot {
+                title: format!("{} vs print progress", q.label),
+                x_label: "print progress [%]".into(),
+                y_label: format!("{} [{}]", q.label, q.unit),
+                series: vec![
+                    Series {
+                        name: "min over printed".into(),
+                        points: lo,
+                    },
+                    Series {
+                        name: "max over printed".into(),
+                        points: hi,
+                    },
+                ],
+            },
+            markers: station_markers_progress(input),
+            cursor: CursorAxis::Progress,
+            ..PlotSpec::default()
+        });
+    }
+    out
+}
+
+/// Print progress (%) at which each robot station after the first starts: the progress of the
+/// first state that shows the station's first layer.
+fn station_markers_progress(input: &ReportInput) -> Vec<VerticalMarker> {
+    let Some(cell) = &input.cell else {
+        return Vec::new();
+    };
+    cell.stations
+        .iter()
+        .enumerate()
+        .skip(1)
+        .filter_map(|(k, st)| {
+            let first = st.layers.first()?;
+            let q = input.layers.iter().position(|l| l.id == *first)?;
+            let s = input.states.iter().find(|s| s.layers_printed > q)?;
+            Some(VerticalMarker {
+                name: format!("station {}", k + 1),
+                x: 100.0 * s.progress,
+            })
+        })
+        .collect()
+}
+
+/// Robot time at which each station after the first starts.
+fn station_markers_time(input: &ReportInput) -> Vec<VerticalMarker> {
+    let Some(robot) = &input.robot else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (i, w) in robot.station.windows(2).enumerate() {
+        if let ([a, b], Some(t)) = (w, robot.times.get(i + 1))
+            && a != b
+        {
+            out.push(VerticalMarker {
+                name: format!("station {}", b + 1),
+                x: *t,
+            });
+        }
     }
     out
 }
@@ -221,92 +382,249 @@ fn series_colour(i: usize) -> RGBColor {
     RGBColor(c.0, c.1, c.2)
 }
 
+/// Tick values in plot coordinates: multiples of 1, 2 or 5 × 10^k, about five over the range;
+/// on a log axis (coordinates are log10 of the values) the values 1, 2, 5 × 10^k inside it.
+fn ticks(lo: f64, hi: f64, log: bool) -> Vec<f64> {
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+        return Vec::new();
+    }
+    if log {
+        let mut out = Vec::new();
+        let (k0, k1) = (lo.floor() as i32, hi.ceil() as i32);
+        let decades = k1 - k0;
+        for k in k0..=k1 {
+            let mantissas: &[f64] = if decades > 3 {
+                &[1.0]
+            } else {
+                &[1.0, 2.0, 5.0]
+            };
+            for m in mantissas {
+                let v = (m * 10f64.powi(k)).log10();
+                if v >= lo - 1e-12 && v <= hi + 1e-12 {
+                    out.push(v);
+                }
+            }
+        }
+        return out;
+    }
+    let raw = (hi - lo) / 5.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| *s >= raw)
+        .unwrap_or(10.0 * mag);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|i| i as f64 * step).collect()
+}
+
 /// Draws `spec` as an SVG document string of size [`PLOT_SIZE`].
+///
+/// # Errors
+/// As [`render_plot`].
+pub fn render_svg(spec: &PlotSpec) -> Result<String, ReportError> {
+    render_plot(spec).map(|r| r.svg)
+}
+
+/// Draws `spec` as an SVG of size [`PLOT_SIZE`]: 14 px tick labels, the legend in a strip below
+/// the plotting area (never on the data), limits dashed red under the series, station changes
+/// dotted grey; on a log axis values ≤ 0 are left out.
 ///
 /// # Errors
 /// [`ReportError::Plot`] when plotters fails (it only fails on backend errors, which for the
 /// in-memory SVG backend do not occur in practice).
-pub fn render_svg(spec: &PlotSpec) -> Result<String, ReportError> {
+pub fn render_plot(spec: &PlotSpec) -> Result<RenderedPlot, ReportError> {
     let plot = &spec.plot;
     let err = |e: &dyn std::fmt::Display| ReportError::Plot {
         plot: plot.title.clone(),
         message: e.to_string(),
     };
+    let log = spec.log_y;
+    let fy = |y: f64| if log { y.log10() } else { y };
+    let keep = |y: f64| !log || y > 0.0;
     let all = || plot.series.iter().flat_map(|s| s.points.iter());
-    let (x0, x1) = padded_range(all().map(|p| p[0]));
+    let (x0, x1) = padded_range(all().map(|p| p[0]).chain(spec.markers.iter().map(|m| m.x)));
     let (y0, y1) = padded_range(
         all()
             .map(|p| p[1])
-            .chain(spec.reference_lines.iter().map(|r| r.y)),
+            .chain(spec.reference_lines.iter().map(|r| r.y))
+            .filter(|y| keep(*y))
+            .map(fy),
     );
+    let key_points = ticks(y0, y1, log);
+
+    // Legend entries: (kind, colour, text); kind 0 solid, 1 dashed, 2 dotted.
+    let mut entries: Vec<(u8, RGBColor, String)> = plot
+        .series
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (0, series_colour(i), s.name.clone()))
+        .collect();
+    entries.extend(
+        spec.reference_lines
+            .iter()
+            .map(|r| (1, RED, format!("limit {} = {}", r.name, fmt_num(r.y)))),
+    );
+    entries.extend(spec.markers.iter().map(|m| {
+        (
+            2,
+            RGBColor(90, 90, 90),
+            format!("{} at {}", m.name, fmt_num(m.x)),
+        )
+    }));
+    // Rows of entries, ~7.2 px per character at 13 px.
+    let width = i32::try_from(PLOT_SIZE.0).unwrap_or(560);
+    let mut rows: Vec<Vec<(i32, usize)>> = vec![Vec::new()];
+    let mut x = 12;
+    for (k, e) in entries.iter().enumerate() {
+        let w = 30 + (e.2.chars().count() as f64 * 7.2) as i32 + 16;
+        if x + w > width - 8 && rows.last().is_some_and(|r| !r.is_empty()) {
+            rows.push(Vec::new());
+            x = 12;
+        }
+        if let Some(r) = rows.last_mut() {
+            r.push((x, k));
+        }
+        x += w;
+    }
+    let legend_h = 8 + 20 * rows.len() as u32;
 
     let mut svg = String::new();
+    let mut frame = PlotFrame {
+        x0,
+        x1,
+        ..PlotFrame::default()
+    };
     {
         let root = SVGBackend::with_string(&mut svg, PLOT_SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(|e| err(&e))?;
-        let mut chart = ChartBuilder::on(&root)
+        let (upper, lower) = root.split_vertically(PLOT_SIZE.1.saturating_sub(legend_h));
+        let mut chart = ChartBuilder::on(&upper)
             .caption(&plot.title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(64)
+            .margin(10)
+            .x_label_area_size(46)
+            .y_label_area_size(70)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(|e| err(&e))?;
+        // y ticks are ours (1-2-5 steps, also on the log axis): plotters' labels are off.
         chart
             .configure_mesh()
             .x_desc(plot.x_label.as_str())
             .y_desc(plot.y_label.as_str())
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 15))
+            .x_label_formatter(&|v| fmt_num(*v))
+            .y_labels(0)
+            .disable_y_mesh()
             .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.08))
             .draw()
             .map_err(|e| err(&e))?;
-
-        for (i, s) in plot.series.iter().enumerate() {
-            let colour = series_colour(i);
-            let style = ShapeStyle::from(&colour).stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().map(|p| (p[0], p[1])),
-                    style,
-                ))
-                .map_err(|e| err(&e))?
-                .label(s.name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-            // Markers only for short series, where they show the sampling (the states).
-            if s.points.len() <= 60 {
-                chart
-                    .draw_series(
-                        s.points
-                            .iter()
-                            .map(|p| Circle::new((p[0], p[1]), 2, colour.filled())),
-                    )
-                    .map_err(|e| err(&e))?;
-            }
+        let grid = ShapeStyle::from(&BLACK.mix(0.08)).stroke_width(1);
+        chart
+            .draw_series(
+                key_points
+                    .iter()
+                    .map(|&v| PathElement::new(vec![(x0, v), (x1, v)], grid)),
+            )
+            .map_err(|e| err(&e))?;
+        let tick_font = ("sans-serif", 14)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Right, VPos::Center));
+        for &v in &key_points {
+            let (px, py) = chart.backend_coord(&(x0, v));
+            let label = if log {
+                fmt_num(10f64.powf(v))
+            } else {
+                fmt_num(v)
+            };
+            upper
+                .draw(&PathElement::new(vec![(px - 5, py), (px, py)], BLACK))
+                .map_err(|e| err(&e))?;
+            upper
+                .draw(&Text::new(label, (px - 8, py), tick_font.clone()))
+                .map_err(|e| err(&e))?;
         }
-        for r in &spec.reference_lines {
-            let style = ShapeStyle::from(&RED).stroke_width(1);
-            // plotters has no dash style for series; draw the limit as short pieces.
-            let n = 40;
+
+        // Limits and station changes first, so the series lie on top of them.
+        let red = ShapeStyle::from(&RED).stroke_width(1);
+        for r in spec.reference_lines.iter().filter(|r| keep(r.y)) {
+            let y = fy(r.y);
+            let n = 60;
             let pieces = (0..n).step_by(2).map(|k| {
                 let a = x0 + (x1 - x0) * f64::from(k) / f64::from(n);
                 let b = x0 + (x1 - x0) * f64::from(k + 1) / f64::from(n);
-                PathElement::new(vec![(a, r.y), (b, r.y)], style)
+                PathElement::new(vec![(a, y), (b, y)], red)
             });
-            chart
-                .draw_series(pieces)
-                .map_err(|e| err(&e))?
-                .label(format!("limit {} = {}", r.name, fmt_num(r.y)))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            chart.draw_series(pieces).map_err(|e| err(&e))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.4))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(|e| err(&e))?;
+        let grey = ShapeStyle::from(&RGBColor(90, 90, 90)).stroke_width(1);
+        for m in &spec.markers {
+            let n = 40;
+            let pieces = (0..n).step_by(2).map(|k| {
+                let a = y0 + (y1 - y0) * f64::from(k) / f64::from(n);
+                let b = y0 + (y1 - y0) * (f64::from(k) + 0.6) / f64::from(n);
+                PathElement::new(vec![(m.x, a), (m.x, b)], grey)
+            });
+            chart.draw_series(pieces).map_err(|e| err(&e))?;
+        }
+        for (i, s) in plot.series.iter().enumerate() {
+            let colour = series_colour(i);
+            let style = ShapeStyle::from(&colour).stroke_width(2);
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .filter(|p| keep(p[1]))
+                .map(|p| (p[0], fy(p[1])))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(pts.iter().copied(), style))
+                .map_err(|e| err(&e))?;
+            // Markers only for short series, where they show the sampling (the states).
+            if pts.len() <= 60 {
+                chart
+                    .draw_series(pts.iter().map(|p| Circle::new(*p, 2, colour.filled())))
+                    .map_err(|e| err(&e))?;
+            }
+        }
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        frame.px0 = xr.start;
+        frame.px1 = xr.end;
+        frame.py0 = yr.start;
+        frame.py1 = yr.end;
+
+        // The legend strip.
+        for (row, items) in rows.iter().enumerate() {
+            let y = 12 + 20 * row as i32;
+            for &(x, k) in items {
+                let Some((kind, colour, text)) = entries.get(k) else {
+                    continue;
+                };
+                let style = ShapeStyle::from(colour).stroke_width(if *kind == 0 { 2 } else { 1 });
+                let segs: Vec<(i32, i32)> = match kind {
+                    0 => vec![(0, 24)],
+                    1 => vec![(0, 6), (9, 15), (18, 24)],
+                    _ => vec![(0, 3), (6, 9), (12, 15), (18, 21)],
+                };
+                for (a, b) in segs {
+                    lower
+                        .draw(&PathElement::new(vec![(x + a, y), (x + b, y)], style))
+                        .map_err(|e| err(&e))?;
+                }
+                lower
+                    .draw(&Text::new(
+                        text.clone(),
+                        (x + 30, y - 7),
+                        ("sans-serif", 13).into_font().color(&BLACK),
+                    ))
+                    .map_err(|e| err(&e))?;
+            }
+        }
         root.present().map_err(|e| err(&e))?;
     }
-    Ok(svg)
+    Ok(RenderedPlot { svg, frame })
 }
 
 /// Short human number: 4 significant digits, no exponent for everyday magnitudes.

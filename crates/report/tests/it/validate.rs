@@ -59,11 +59,40 @@ fn unknown_layer_and_robot_shapes_are_rejected() {
         ReportError::UnknownLayer { id: 999, .. }
     ));
 
+    // Without a cell the robot needs its capsule poses.
     let mut input = demo_input();
-    input.robot.as_mut().unwrap().poses[7].pop();
+    input.cell = None;
     assert!(matches!(
         render_html(&input).unwrap_err(),
-        ReportError::LengthMismatch { field, .. } if field == "robot.poses[7]"
+        ReportError::LengthMismatch { field, .. } if field == "robot.poses"
+    ));
+
+    let mut input = demo_input();
+    input.robot.as_mut().unwrap().station[3] = 7;
+    assert!(matches!(
+        render_html(&input).unwrap_err(),
+        ReportError::OutOfRange { field, .. } if field == "robot.station[3]"
+    ));
+
+    let mut input = demo_input();
+    input.timeline.as_mut().unwrap().point_time.pop();
+    assert!(matches!(
+        render_html(&input).unwrap_err(),
+        ReportError::LengthMismatch { field, .. } if field == "timeline.point_time"
+    ));
+
+    let mut input = demo_input();
+    input.modes[2].displacement.pop();
+    assert!(matches!(
+        render_html(&input).unwrap_err(),
+        ReportError::LengthMismatch { field, .. } if field == "modes[2].displacement"
+    ));
+
+    let mut input = demo_input();
+    input.quantities[0].states[4].push(1.0);
+    assert!(matches!(
+        render_html(&input).unwrap_err(),
+        ReportError::LengthMismatch { field, .. } if field == "quantities[0].states[4]"
     ));
 
     let mut input = demo_input();
