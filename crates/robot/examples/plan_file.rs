@@ -47,6 +47,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| plan + timing + check | programs | lint | total |\n|---|---|---|---|\n| {t_plan:.3} s | {t_prog:.3} s | {t_lint:.3} s | {:.3} s |",
         t_plan + t_prog + t_lint
     );
+    let t = Instant::now();
+    let m = kappe_robot::meshes::verify_meshes(&plan, 1)?;
+    println!(
+        "meshes ({:.3} s, {} waypoints): arm capsules env {:.4} m ({}), self {:.4} m ({}); arm meshes env {:.4} m ({}), self {:.4} m ({}); nozzle {:.4} m ({}); problems {}",
+        t.elapsed().as_secs_f64(),
+        m.waypoints_checked,
+        m.capsules.environment.distance,
+        m.capsules.environment.what,
+        m.capsules.self_distance.distance,
+        m.capsules.self_distance.what,
+        m.meshes.environment.distance,
+        m.meshes.environment.what,
+        m.meshes.self_distance.distance,
+        m.meshes.self_distance.what,
+        m.nozzle.distance,
+        m.nozzle.what,
+        m.problems.len()
+    );
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir)?;
         for f in &files {

@@ -665,6 +665,55 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// Nearest object to an arbitrary parry shape at `pose` (world), e.g. a link's convex
+    /// collision mesh: static shapes and printed layers with tag < `layer_tag`, pruned by
+    /// bounding boxes. Returns (distance capped at `cutoff`, object name).
+    pub fn shape_clearance(
+        &self,
+        pose: &Pose,
+        shape: &dyn parry3d_f64::shape::Shape,
+        layer_tag: usize,
+        cutoff: f64,
+    ) -> (f64, Option<String>) {
+        let aabb = shape.compute_aabb(pose);
+        let (lo, hi) = (aabb.mins, aabb.maxs);
+        let mut best = cutoff;
+        let mut name: Option<&str> = None;
+        for s in &self.shapes {
+            if box_gap(lo, hi, s.lo, s.hi) > best {
+                continue;
+            }
+            if let Ok(d) = query::distance(pose, shape, &s.pose, s.shape.as_ref())
+                && d.distance < best
+            {
+                best = d.distance;
+                name = Some(&s.name);
+            }
+        }
+        for ch in &self.soup.chunks {
+            if ch.layer > layer_tag || box_gap(lo, hi, ch.lo, ch.hi) > best {
+                continue;
+            }
+            for &(a, b, r) in &self.soup.segs[ch.start..ch.end] {
+                let seg_lo = a.min(b) - DVec3::splat(r);
+                let seg_hi = a.max(b) + DVec3::splat(r);
+                if box_gap(lo, hi, seg_lo, seg_hi) > best {
+                    continue;
+                }
+                let c = Capsule::new(a, b, r);
+                if let Ok(d) = query::distance(pose, shape, &Pose::IDENTITY, &c)
+                    && d.distance < best
+                {
+                    best = d.distance;
+                    name = self.names.get(ch.name_idx).map(String::as_str);
+                }
+            }
+        }
+        (best, name.map(str::to_owned))
+    }
+}
+
 /// A mobile-base body box, in the robot base frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -17,6 +17,7 @@ pub mod frames;
 pub mod kinematics;
 pub mod ladder;
 pub mod lint;
+pub mod meshes;
 pub mod plan;
 pub mod program;
 pub mod setup;

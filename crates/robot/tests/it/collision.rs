@@ -141,3 +141,54 @@ fn invalid_obstacles_are_rejected() {
         "{err}"
     );
 }
+
+/// The URDF chain that poses the collision meshes ends at `tool0` = the DH flange: the two
+/// kinematic descriptions agree (robot.md §1.2: 6e-10, the URDF rounds π/2 to 1.570796327;
+/// 1e-8 m / 1e-8 rad leaves room for that and f64 round-off).
+#[test]
+fn urdf_chain_of_the_meshes_matches_the_dh_flange() {
+    use kappe_robot::meshes::urdf_link_frames;
+    let fx = fixture("ur10e_ik.json");
+    for case in fx["fk_cases"].as_array().unwrap().iter().take(50) {
+        let q = joints(&case["q"]);
+        let (_, tool0) = urdf_link_frames(&q);
+        let dh = kappe_robot::UR10E.fk(&q);
+        assert!((tool0.t - dh.t).length() < 1e-8, "{q:?}");
+        assert!(tool0.rotation_angle_to(&dh) < 1e-8, "{q:?}");
+    }
+}
+
+/// The meshes load as convex hulls with the vertex counts of the STL files (robot.md: 71–939),
+/// and every hull lies inside its link's capsules inflated by a few centimetres (the capsules
+/// were fitted to the visual meshes, which the collision hulls wrap): a gross misplacement of a
+/// mesh (wrong origin or rotation) would put it tens of centimetres away.
+#[test]
+fn meshes_sit_on_their_links() {
+    use kappe_robot::collision::ur10e_arm_capsules;
+    use kappe_robot::meshes::ArmMeshes;
+    use parry3d_f64::shape::Shape;
+    let m = ArmMeshes::load().unwrap();
+    assert_eq!(m.hulls.len(), 7);
+    let q = [0.3, -1.2, 1.4, -0.7, 1.1, 0.4];
+    let poses = m.poses(&q, &kappe_robot::Iso::IDENTITY);
+    let frames = kappe_robot::UR10E.fk_frames(&q);
+    let caps = ur10e_arm_capsules();
+    for i in 0..7 {
+        // Mesh centre (AABB centre) to the nearest capsule axis of the same link.
+        let bb = m.hulls[i].compute_aabb(&poses[i]);
+        let c = (bb.mins + bb.maxs) * 0.5;
+        let d = caps
+            .iter()
+            .filter(|k| k.link == i)
+            .map(|k| {
+                let a = frames[i].point(k.a.into());
+                let b = frames[i].point(k.b.into());
+                let t = ((c - a).dot(b - a) / (b - a).length_squared().max(1e-12)).clamp(0.0, 1.0);
+                (a + (b - a) * t - c).length() - k.radius
+            })
+            .fold(f64::INFINITY, f64::min);
+        // 0.05 m: the hull's box centre may sit off the capsule axis by up to its radius
+        // plus the hull/capsule fit difference.
+        assert!(d < 0.05, "link {i}: mesh centre {d} m outside its capsules");
+    }
+}

@@ -397,3 +397,18 @@ fn lint_rejects_what_the_controller_would() {
         );
     }
 }
+
+#[test]
+fn plan_clears_ur_collision_meshes() {
+    let (layers, setup, opts) = small();
+    let plan = plan_print(&layers[..6], &setup, &opts).unwrap();
+    let rep = kappe_robot::meshes::verify_meshes(&plan, 1).unwrap();
+    assert_eq!(rep.waypoints_checked, plan.waypoint_count());
+    assert!(rep.problems.is_empty(), "{:?}", rep.problems);
+    // Both models report a positive clearance to the environment and on the self pairs; the
+    // capsule model is what the planner held to its 10 mm margin.
+    assert!(rep.meshes.environment.distance > 0.0);
+    assert!(rep.meshes.self_distance.distance > 0.0);
+    assert!(rep.capsules.environment.distance >= opts.clearance);
+    assert!(rep.nozzle.distance >= opts.clearance);
+}
