@@ -179,6 +179,12 @@ pub struct Resolved {
 }
 
 impl BuildabilitySpec {
+    /// Parse TOML (unknown fields are errors with a did-you-mean hint) without checking the
+    /// values (see [`BuildabilitySpec::resolve`]).
+    pub fn parse(text: &str) -> Result<BuildabilitySpec, DesignError> {
+        crate::spec::parse_toml(text)
+    }
+
     /// Parse TOML (unknown fields are errors with a did-you-mean hint) and check it.
     pub fn from_toml_str(text: &str) -> Result<Resolved, DesignError> {
         let spec: BuildabilitySpec = crate::spec::parse_toml(text)?;

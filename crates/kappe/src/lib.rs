@@ -22,6 +22,7 @@ pub mod material;
 pub mod mesh;
 pub mod path;
 pub mod pipeline;
+pub mod print_calibration;
 pub mod robot_plan;
 pub mod schedule;
 pub mod section;

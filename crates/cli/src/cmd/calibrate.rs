@@ -17,6 +17,20 @@
 //! outcome = "failed"
 //! failed_at_layer = 57       # layers printed when it collapsed, from 1 in print order
 //! ```
+//!
+//! A file with a `[buildability]` table calibrates the green-state time model from buildability
+//! prints instead (`kappe::print_calibration`):
+//! ```toml
+//! buildability = "cylinder.toml"   # a buildability spec (path relative to this file, or inline)
+//! [fit]
+//! parameter = "compressive_strength_rate"   # the one [material.time] field to fit
+//! min = 0.0
+//! max = 20.0
+//! [[print]]
+//! name = "C1"
+//! failed_at_layer = 30             # or stood_to = n
+//! # layer_time = 18.85             # s, if it differs from the spec's
+//! ```
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -75,6 +89,12 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
     let path = &args.prototypes;
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read the prototype file {}", path.display()))?;
+    if text
+        .parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("buildability"))
+    {
+        return run_prints(&args, &text);
+    }
     let file = PrototypeFile::from_toml_str(&text)
         .with_context(|| format!("invalid prototype file {}", path.display()))?;
     let base = path.parent().unwrap_or(Path::new("."));
@@ -126,4 +146,64 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
     } else {
         ExitCode::from(2)
     })
+}
+
+/// `kappe calibrate` of a file with `[buildability]`: fit the time model to buildability prints.
+fn run_prints(args: &CalibrateArgs, text: &str) -> Result<ExitCode> {
+    use kappe::print_calibration::{PrintCalibrationFile, SpecSource, calibrate_prints};
+    let path = &args.prototypes;
+    let file = PrintCalibrationFile::from_toml_str(text)
+        .with_context(|| format!("invalid calibration file {}", path.display()))?;
+    let spec = match &file.buildability {
+        SpecSource::Inline(s) => (**s).clone(),
+        SpecSource::Path(rel) => {
+            let p = path.parent().unwrap_or(Path::new(".")).join(rel);
+            let t = std::fs::read_to_string(&p)
+                .with_context(|| format!("cannot read the buildability spec {}", p.display()))?;
+            kappe::buildability::BuildabilitySpec::parse(&t)
+                .with_context(|| format!("invalid buildability spec {}", p.display()))?
+        }
+    };
+    if let Some(out) = &args.out {
+        crate::output::check_user_file(out, false)?;
+    }
+    let cal = calibrate_prints(&spec, &file.fit, &file.prints).context("calibration failed")?;
+    let doc = serde_json::json!({
+        "format": "kappe.calibration.prints",
+        "version": 1,
+        "fit": file.fit,
+        "calibration": cal,
+    });
+    if let Some(out) = &args.out {
+        write_file_atomic(out, &serde_json::to_vec_pretty(&doc)?)?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(ExitCode::SUCCESS);
+    }
+    let name = cal.parameter.name();
+    println!("Calibration of {name} from {} prints", cal.prints.len());
+    println!(
+        "  {:<12} {:>9} {:>14} {:>14} {:>10} {:>9}",
+        "print", "observed", "lower", "upper", "predicted", "mode"
+    );
+    let f = |v: Option<usize>| v.map_or("stood".to_string(), |x| x.to_string());
+    for e in &cal.prints {
+        println!(
+            "  {:<12} {:>9} {:>14.6e} {:>14.6e} {:>10} {:>9}",
+            e.name,
+            f(e.observed_failure_layer),
+            e.lower,
+            e.upper,
+            f(e.predicted_failure_layer),
+            e.predicted_mode.map_or("-", |m| m.name())
+        );
+    }
+    println!(
+        "  {name} = {:.6e} ± {:.3e}  (allowed by the data: [{:.6e}, {:.6e}])",
+        cal.value, cal.uncertainty, cal.interval[0], cal.interval[1]
+    );
+    println!();
+    println!("{}", cal.explanation);
+    Ok(ExitCode::SUCCESS)
 }
