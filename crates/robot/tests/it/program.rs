@@ -99,14 +99,14 @@ fn rows(plan: &Plan) -> Vec<Row> {
         .collect()
 }
 
-#[test]
-fn trajectory_rows_respect_limits_and_stay_on_the_path() {
-    let (layers, setup, opts) = small();
-    let plan = plan_print(&layers, &setup, &opts).unwrap();
-    let rows = rows(&plan);
-    // UR10e: 120 °/s joints 1–2, 180 °/s joints 3–6, used up to speed_fraction; 5 rad/s².
+/// Check a plan from its `trajectory.csv` rows alone (see the module docs); returns the number
+/// of print moves whose speed was checked against the design speed and the number inside
+/// reported slowdowns.
+fn check_rows(plan: &Plan, layers: &[PrintLayer], opts: &PlanOptions, amax: f64) -> (usize, usize) {
+    let rows = rows(plan);
+    // UR10e: 120 °/s joints 1–2, 180 °/s joints 3–6, used up to speed_fraction.
     let vmax: [f64; 6] = [120.0, 120.0, 180.0, 180.0, 180.0, 180.0].map(|d: f64| d.to_radians());
-    let amax = 5.0;
+    let mut slowed = 0;
     let target = |layer: i64, index: usize| {
         layers
             .iter()
@@ -114,7 +114,7 @@ fn trajectory_rows_respect_limits_and_stay_on_the_path() {
             .and_then(|l| l.points.iter().find(|p| p.index == index))
             .unwrap()
     };
-    let base = Iso::from_mat4_unchecked(&plan.stations[0].world_from_base).to_mat4();
+    let base = plan.stations[0].world_from_base;
     let tool = plan.flange_from_tcp;
     let slow = |layer: i64, index: usize| {
         plan.slowdowns
@@ -176,7 +176,11 @@ fn trajectory_rows_respect_limits_and_stay_on_the_path() {
             .sqrt();
         if dist > 0.0 {
             let speed = dist / dt;
-            if !slow(r.layer, r.index) {
+            if slow(r.layer, r.index) {
+                slowed += 1;
+                // A slowdown is reported where the tool is below 98 % of the design speed.
+                assert!(speed < opts.print_speed);
+            } else {
                 assert!(
                     (speed / opts.print_speed - 1.0).abs() <= 0.02,
                     "tool at {speed} m/s at layer {} point {}",
@@ -193,12 +197,63 @@ fn trajectory_rows_respect_limits_and_stay_on_the_path() {
         }
     }
     assert!(max_pos_err <= 1e-6, "{max_pos_err}");
-    assert!(checked_speed > 0);
+    (checked_speed, slowed)
+}
+
+#[test]
+fn trajectory_rows_respect_limits_and_stay_on_the_path() {
+    let (layers, setup, opts) = small();
+    let plan = plan_print(&layers, &setup, &opts).unwrap();
+    // 5 rad/s²: the default acceleration limit.
+    let (checked, _) = check_rows(&plan, &layers, &opts, 5.0);
+    assert!(checked > 0);
+    let rows = rows(&plan);
     // Every layer change is a printed move: the rows go straight from a layer's last point to
     // the next layer's first (no row off the path in between, checked above by the FK).
     assert_eq!(
         rows.iter().filter(|r| r.index == 0).count(),
         16 + 1, // + the priming hold row at the very first target
+    );
+}
+
+/// With a low acceleration limit the tool must slow down at the corners of the path (the
+/// layer changes turn by 90° twice): the rows still respect the limit, the slow moves are
+/// reported, and the flow set-point follows the lower speed (checked in `check_rows`).
+#[test]
+fn where_the_limits_bind_the_tool_and_the_flow_slow_down_and_it_is_reported() {
+    let (layers, setup, mut opts) = small();
+    // A third of the largest acceleration the plan needs at the default limit.
+    let free = plan_print(&layers[..4], &setup, &opts).unwrap();
+    let amax = free.max_acceleration_ratio * 5.0 / 3.0;
+    opts.limits.max_acceleration = [amax; 6];
+    let plan = plan_print(&layers[..4], &setup, &opts).unwrap();
+    assert!(!plan.slowdowns.is_empty());
+    assert!(plan.max_acceleration_ratio <= 1.0 + 1e-9);
+    let (checked, slowed) = check_rows(&plan, &layers, &opts, amax);
+    assert!(checked > 0 && slowed > 0, "{checked} {slowed}");
+    assert!(
+        plan.slowdowns
+            .iter()
+            .all(|s| s.reason == "joint acceleration")
+    );
+    let files = program_files(&plan, "p").unwrap();
+    let slow_flow = plan
+        .slowdowns
+        .iter()
+        .map(|s| s.min_speed_ratio)
+        .fold(f64::INFINITY, f64::min)
+        * 0.48;
+    // The lowest flow set-point written equals the slowest move's flow (6 decimals).
+    let min_written = files
+        .iter()
+        .flat_map(|f| f.text.lines())
+        .filter_map(|l| l.trim().strip_prefix("set_standard_analog_out(0, "))
+        .filter_map(|v| v.trim_end_matches(')').parse::<f64>().ok())
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (min_written - slow_flow).abs() < 1e-6,
+        "{min_written} {slow_flow}"
     );
 }
 
