@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end test of the HTML report (issue 8), called by .ci/run:
+# End-to-end test of the HTML report (issues 8, 14), called by .ci/run:
 # writes the demo report, opens it from file:// in headless Debian `chromium` driven by
 # playwright-core (never `playwright`, never a browser download) and checks it (report.test.mjs).
 # Installs what a fresh machine lacks: chromium via apt-get, playwright-core via `npm ci`.
@@ -24,11 +24,16 @@ chromium --version 2>/dev/null | head -1 || true
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 cargo run --quiet -p kappe-report --example demo -- "$OUT/report.html"
-KAPPE_REPORT="$OUT/report.html" KAPPE_SCREENSHOT="${KAPPE_SCREENSHOT:-$OUT/report.png}" \
-  node --test web/e2e/
+KAPPE_REPORT="$OUT/report.html" node --test web/e2e/
 
 # The same checks on a report written by `kappe design` itself: a short cap (quick in a debug
 # build) with the analysis and the robot plan, so every panel of the page holds real data.
 printf '[cap]\nlength = 0.15\n' > "$OUT/short.toml"
 cargo run --quiet -p kappe-cli -- design "$OUT/short.toml" --out "$OUT/design" --quiet --states every:4
-KAPPE_REPORT="$OUT/design/report.html" KAPPE_SCREENSHOT="$OUT/design.png" node --test web/e2e/
+KAPPE_REPORT="$OUT/design/report.html" node --test web/e2e/
+
+# A failing design (a flat, wide cap: sigma_min fails): the page must work just as well, with
+# the failing rows and their places.
+printf '[cap]\nspan = 1.4\nrise = 0.12\nlength = 0.15\n' > "$OUT/fail.toml"
+cargo run --quiet -p kappe-cli -- design "$OUT/fail.toml" --out "$OUT/fail" --quiet --states every:4 --allow-fail
+KAPPE_REPORT="$OUT/fail/report.html" node --test web/e2e/

@@ -1138,6 +1138,7 @@
     layerTimes: () => data.layers.map((_, k) => [layerStart[k], layerEnd[k]]),
     beadWidth: (k) => data.layers[k].bead_width,
     modeShown: () => (modeShown ? modeShown.state : null),
+    camera: () => (camera ? camera.position.toArray() : null),
   };
   const gl = renderer ? renderer.getContext() : null;
   window.KAPPE_READY = {

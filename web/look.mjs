@@ -1,4 +1,5 @@
-// Quick look: node web/e2e/smoke.mjs REPORT.html OUT.png
+// A quick look at a report (console, timings, hook values, screenshots at 25/50/100 %):
+//   node web/look.mjs REPORT.html OUT.png
 import { chromium } from 'playwright-core';
 import { resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
