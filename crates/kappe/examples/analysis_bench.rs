@@ -6,7 +6,7 @@
 
 use std::time::Instant;
 
-use kappe::constraints::{AnalysisOptions, analyze, state_buckling, state_material};
+use kappe::analysis::{AnalysisOptions, analyze, state_buckling, state_material};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let stride: usize = std::env::args()

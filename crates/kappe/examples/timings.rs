@@ -9,7 +9,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cap = kappe::design_cap(&design, &|_| {})?;
     let t_design = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let analysis = kappe::constraints::analyze(&cap, &Default::default(), &|_| {})?;
+    let analysis = kappe::analysis::analyze(&cap, &Default::default(), &|_| {})?;
     let t_analysis = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let plan = kappe::robot_plan::plan_robot(&cap)?;

@@ -22,7 +22,7 @@ use std::collections::BTreeMap;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::constraints::{AnalysisOptions, BucklingStatus, state_buckling, state_material};
+use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling, state_material};
 use crate::error::DesignError;
 use crate::pipeline::{Cap, design_cap};
 use crate::spec::Design;

@@ -21,8 +21,8 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::{Analysis, AnalysisOptions, StateSelection, analyze};
 use crate::calibrate::DesignSource;
-use crate::constraints::{Analysis, AnalysisOptions, StateSelection, analyze};
 use crate::error::DesignError;
 use crate::pipeline::design_cap;
 use crate::spec::Design;

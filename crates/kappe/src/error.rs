@@ -34,6 +34,9 @@ pub enum DesignError {
         /// What is wrong.
         message: String,
     },
+    /// The caller's progress callback asked the run to stop (e.g. Ctrl-C in Python).
+    #[error("cancelled")]
+    Cancelled,
     /// The CEM engine rejected a network we built (a bug in Kappe if it happens).
     #[error("CEM: {0}")]
     Cem(#[from] kappe_cem::CemError),

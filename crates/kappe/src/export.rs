@@ -152,7 +152,7 @@ pub fn summary_json(cap: &Cap) -> Value {
 /// Merge an analysis into `summary.json`: per state `blf`, `max_compression_stress_pa`,
 /// `max_tension_stress_pa` (element stresses of the analysis), `max_overhang_m`, `ok`, and the
 /// top-level `constraints` report and `analysis_ok` verdict.
-pub fn add_analysis(summary: &mut Value, analysis: &crate::constraints::Analysis) {
+pub fn add_analysis(summary: &mut Value, analysis: &crate::analysis::Analysis) {
     if let Some(states) = summary.get_mut("states").and_then(Value::as_array_mut) {
         for (s, a) in states.iter_mut().zip(&analysis.states) {
             if let Some(obj) = s.as_object_mut() {

@@ -10,10 +10,9 @@ pub mod analysis;
 pub mod arch;
 pub mod buildability;
 pub mod calibrate;
-pub mod constraints;
 pub mod design_loop;
-pub mod ends;
 pub mod error;
+pub mod evaluate;
 pub mod export;
 pub mod forces;
 pub mod frame;
@@ -22,14 +21,21 @@ pub mod material;
 pub mod mesh;
 pub mod path;
 pub mod pipeline;
-pub mod print_calibration;
+pub mod report_input;
 pub mod robot_plan;
 pub mod schedule;
 pub mod section;
 pub mod shell;
 pub mod spec;
 pub mod states;
+pub mod study;
+pub mod verdict;
 
+/// The analysis under its old name (`kappe::constraints`), for code written before the split;
+/// use [`analysis`].
+#[doc(hidden)]
+pub use analysis as constraints;
 pub use error::DesignError;
+pub use evaluate::{Options, Outcome, Progress, Stage, evaluate, no_progress, run};
 pub use pipeline::{Cap, StateSummary, design_cap};
 pub use spec::Design;

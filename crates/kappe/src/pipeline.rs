@@ -1,6 +1,8 @@
 //! The whole cap pipeline as one plain function: design → arch → sections → states → forces →
 //! path → mesh. States are independent and solved in parallel (rayon); their order is kept.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::analysis::layer_overhangs;
@@ -82,6 +84,16 @@ fn areas(design: &Design, arch: &Arch) -> Sections2D {
 /// Form-find the layer, build the sections and states, and solve the forces of every state.
 /// `on_state(total)` is called once per solved state (for a progress bar), with the state count.
 pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<Cap, DesignError> {
+    design_cap_until(design, on_state, &AtomicBool::new(false))
+}
+
+/// [`design_cap`] that gives up with [`DesignError::Cancelled`] once `stop` is set (checked
+/// before every state).
+pub(crate) fn design_cap_until(
+    design: &Design,
+    on_state: &(dyn Fn(usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Cap, DesignError> {
     design.validate()?;
     let tilt = design.tilt();
     let frame = LayerFrame::new(tilt);
@@ -111,6 +123,9 @@ pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<
     let area = areas(design, &arch);
     let total = sections.layers.len();
     let solve = |top: usize| {
+        if stop.load(Ordering::Relaxed) {
+            return Err(DesignError::Cancelled);
+        }
         let state = build_state(&sections, &frame, phi, top)?;
         let (topology, pass, forces) = state_forces(&state, area)?;
         on_state(total);

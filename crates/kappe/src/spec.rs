@@ -24,7 +24,7 @@ pub struct Design {
     /// Robot and tool settings (used by the motion planner).
     pub robot: RobotSpec,
     /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
-    pub analysis: crate::constraints::AnalysisOptions,
+    pub analysis: crate::analysis::AnalysisOptions,
 }
 
 /// Global geometry (method.md §2).
@@ -39,10 +39,6 @@ pub struct CapSpec {
     pub length: f64,
     /// am: tilt of every layer plane from the vertical, degrees.
     pub tilt_deg: f64,
-    /// What the first centre layer leans on: `"start_section"` (default, method.md §6) or
-    /// `"end_wall"` (an end wall takes the stack thrust; `kappe::ends`).
-    #[serde(skip_serializing_if = "crate::ends::EndKind::is_default")]
-    pub end: crate::ends::EndKind,
 }
 
 /// Material (method.md §2–3).
@@ -150,7 +146,7 @@ impl Default for Design {
             print: PrintSpec::default(),
             constraints: ConstraintSpec::default(),
             robot: RobotSpec::default(),
-            analysis: crate::constraints::AnalysisOptions::default(),
+            analysis: crate::analysis::AnalysisOptions::default(),
         }
     }
 }
@@ -162,7 +158,6 @@ impl Default for CapSpec {
             rise: 0.2,
             length: 0.6,
             tilt_deg: 25.0,
-            end: crate::ends::EndKind::StartSection,
         }
     }
 }

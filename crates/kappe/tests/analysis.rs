@@ -7,7 +7,7 @@
 //! final-state BLF changes by < 0.3 % between 1 and 4 layers per row, and the designs tested
 //! with 8 are far from their limits.
 
-use kappe::constraints::{
+use kappe::analysis::{
     Ageing, AnalysisOptions, BucklingStatus, ElementKind, StateSelection, analyze,
     element_stresses, state_buckling, state_material,
 };
@@ -38,9 +38,9 @@ fn cap(d: &Design) -> Cap {
 }
 
 fn constraint<'a>(
-    a: &'a kappe::constraints::Analysis,
+    a: &'a kappe::analysis::Analysis,
     name: &str,
-) -> &'a kappe::constraints::ConstraintResult {
+) -> &'a kappe::analysis::ConstraintResult {
     a.constraints.iter().find(|c| c.name == name).unwrap()
 }
 
@@ -329,7 +329,7 @@ fn mechanism_is_reported_with_its_layer() {
     let o = AnalysisOptions::default();
     let mut sh = state_shell(&state, &state_material(&c, &o, q), 1).unwrap();
     sh.model.supports.clear();
-    let b = kappe::constraints::shell_buckling(&sh, q, &o).unwrap();
+    let b = kappe::analysis::shell_buckling(&sh, q, &o).unwrap();
     assert_eq!(b.status, BucklingStatus::Mechanism);
     assert!(b.factors.is_empty());
     let m = b.mechanism.unwrap();

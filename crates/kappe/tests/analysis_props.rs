@@ -3,7 +3,7 @@
 //! coarse sampling, 4 layers per mesh row) keep the unoptimised test build quick.
 
 use kappe::Design;
-use kappe::constraints::{AnalysisOptions, state_buckling, state_material};
+use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
 use kappe::states::build_state;
 
 fn small() -> Design {

@@ -57,41 +57,50 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
                 .with_context(|| format!("invalid design file {}", path.display()))?
         }
     };
+    // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
+    let mut options = kappe::Options::of(&design);
+    if let Some(analysis) = options.analysis.as_mut() {
+        if let Some(states) = &args.states {
+            analysis.states = states
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--states: {e}"))?;
+        }
+        if args.no_buckling {
+            analysis.buckling = false;
+        }
+    }
+    // Robot: planned (and verified inside the planner) unless disabled.
+    options.robot = !args.no_robot;
     let silent = args.quiet || args.json;
     let bar = state_bar("print states", silent);
-    let cap = kappe::design_cap(&design, &|total| tick(&bar, total))?;
-    bar.finish_and_clear();
-
-    // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
-    let mut options = cap.design.analysis.clone();
-    if let Some(states) = &args.states {
-        options.states = states
-            .parse()
-            .map_err(|e| anyhow::anyhow!("--states: {e}"))?;
-    }
-    if args.no_buckling {
-        options.buckling = false;
-    }
     let fe_bar = state_bar("analysis", silent);
     let spinner = if silent {
         ProgressBar::hidden()
     } else {
         ProgressBar::new_spinner()
     };
-    // Robot: planned (and verified inside the planner) unless disabled.
-    let eval = crate::report_input::evaluate(
-        &cap,
-        Some(&options),
-        cap.design.robot.enabled && !args.no_robot,
-        &|total| tick(&fe_bar, total),
-        &|| {
-            fe_bar.finish_and_clear();
-            spinner.set_message("planning the UR10e trajectory");
-            spinner.enable_steady_tick(std::time::Duration::from_millis(120));
-        },
-    )?;
+    let on_progress = |p: kappe::Progress| {
+        match p.stage {
+            kappe::Stage::States => tick(&bar, p),
+            kappe::Stage::Analysis => {
+                bar.finish_and_clear();
+                tick(&fe_bar, p);
+            }
+            kappe::Stage::Robot if p.done == 0 => {
+                bar.finish_and_clear();
+                fe_bar.finish_and_clear();
+                spinner.set_message("planning the UR10e trajectory");
+                spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+            }
+            kappe::Stage::Robot => {}
+        }
+        std::ops::ControlFlow::Continue(())
+    };
+    let eval = kappe::run(&design, &options, &on_progress)?;
+    bar.finish_and_clear();
     fe_bar.finish_and_clear();
     spinner.finish_and_clear();
+    let cap = &eval.cap;
     let (analysis, robot, ok) = (&eval.analysis, &eval.robot, eval.ok);
     let mut programs: Vec<String> = Vec::new();
     let mut trajectory: Vec<u8> = Vec::new();
@@ -101,9 +110,9 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         kappe_robot::write_urscript(plan, &mut program)?;
         programs = kappe_robot::urscript_programs(plan)?;
     }
-    let report = kappe_report::render_html(&crate::report_input::report_input(&cap, &eval.extras))?;
-    let summary = eval.summary(&cap);
-    let network = kappe::export::network_json(&cap)?;
+    let report = eval.report_html()?;
+    let summary = eval.summary();
+    let network = kappe::export::network_json(cap)?;
     write_dir_atomic(&args.out, |dir| {
         std::fs::write(
             dir.join("summary.json"),
@@ -135,7 +144,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if !args.quiet {
-        print_table(&cap, &args.out);
+        print_table(cap, &args.out);
         if let Some(analysis) = analysis {
             print!("{}", indent(&analysis.report()));
         }
@@ -192,9 +201,9 @@ fn state_bar(message: &'static str, hidden: bool) -> ProgressBar {
     b
 }
 
-fn tick(bar: &ProgressBar, total: usize) {
-    bar.set_length(total as u64);
-    bar.inc(1);
+fn tick(bar: &ProgressBar, p: kappe::Progress) {
+    bar.set_length(p.total as u64);
+    bar.set_position(p.done as u64);
 }
 
 fn indent(text: &str) -> String {

@@ -1,0 +1,156 @@
+//! The linear buckling run of one print state: its shell model ([`crate::shell`]) under
+//! self-weight, solved by `kappe_fe::buckling`; the lowest positive factor is the state's BLF.
+//! A shell model that is a mechanism is reported with the layers of its free motion.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+
+use super::ageing::layer_ages;
+use super::options::AnalysisOptions;
+use crate::error::DesignError;
+use crate::pipeline::Cap;
+use crate::shell::{NoShell, ShellMaterial, StateShell, state_shell};
+use crate::states::State;
+
+/// What the buckling analysis of a state did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BucklingStatus {
+    /// Analysed; `blf` holds the factor.
+    Analysed,
+    /// Not in the state selection (or buckling switched off).
+    Skipped,
+    /// A single layer on the bed: no shell surface.
+    SingleLayer,
+    /// The shell model is a mechanism (see `mechanism`).
+    Mechanism,
+    /// The load produces no compressive buckling mode (no positive factor).
+    NoPositiveFactor,
+}
+
+/// The shell material of the state with top print index `top`: the design's material, with
+/// every layer's modulus from its age when `options.ageing` is set.
+pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> ShellMaterial {
+    let d = &cap.design;
+    let layer_modulus = match &options.ageing {
+        None => HashMap::new(),
+        Some(a) => layer_ages(&cap.sections, d.print.print_speed, top)
+            .into_iter()
+            .map(|(id, t)| (id, a.modulus(t)))
+            .collect(),
+    };
+    ShellMaterial {
+        thickness: d.print.layer_width,
+        poisson_ratio: d.material.poisson_ratio,
+        unit_weight: d.material.specific_weight,
+        layer_modulus,
+        youngs_modulus: d.material.youngs_modulus,
+    }
+}
+
+/// Result of the buckling analysis of one state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StateBuckling {
+    /// What happened.
+    pub status: BucklingStatus,
+    /// Factors found, ascending.
+    pub factors: Vec<f64>,
+    /// Where mode 1 peaks (layer id, position), or where the mechanism is.
+    pub location: Option<(i32, [f64; 3])>,
+    /// Mechanism description.
+    pub mechanism: Option<String>,
+    /// Shell nodes.
+    pub shell_nodes: usize,
+}
+
+/// Buckling analysis of one state (shell model + `kappe_fe::buckling`).
+pub fn state_buckling(
+    state: &State,
+    material: &ShellMaterial,
+    options: &AnalysisOptions,
+) -> Result<StateBuckling, DesignError> {
+    let shell = match state_shell(state, material, options.row_stride) {
+        Ok(s) => s,
+        Err(NoShell::SingleLayer) => {
+            return Ok(StateBuckling {
+                status: BucklingStatus::SingleLayer,
+                factors: Vec::new(),
+                location: None,
+                mechanism: None,
+                shell_nodes: 0,
+            });
+        }
+    };
+    shell_buckling(&shell, state.index, options)
+}
+
+/// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
+/// errors). A mechanism is reported with the layers of the free DOFs, not as an error.
+pub fn shell_buckling(
+    shell: &StateShell,
+    state: usize,
+    options: &AnalysisOptions,
+) -> Result<StateBuckling, DesignError> {
+    let fe_opts = kappe_fe::BucklingOptions {
+        modes: options.modes,
+        // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
+        // modelling error and saves Lanczos steps over the default 1e-10.
+        tolerance: 1e-8,
+        sturm_check: options.sturm_check,
+        ..Default::default()
+    };
+    let n = shell.model.nodes.len();
+    match kappe_fe::buckling(&shell.model, &fe_opts) {
+        Ok(r) => {
+            let location = r.modes.first().and_then(|m| {
+                let (i, _) = m
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| (i, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))?;
+                Some((*shell.node_layer.get(i)?, *shell.model.nodes.get(i)?))
+            });
+            Ok(StateBuckling {
+                status: if r.factors.is_empty() {
+                    BucklingStatus::NoPositiveFactor
+                } else {
+                    BucklingStatus::Analysed
+                },
+                factors: r.factors,
+                location,
+                mechanism: None,
+                shell_nodes: n,
+            })
+        }
+        Err(kappe_fe::FeError::Mechanism { free_dofs }) => {
+            let mut layers: Vec<i32> = free_dofs
+                .iter()
+                .filter_map(|d| shell.node_layer.get(d.node).copied())
+                .collect();
+            let first = free_dofs.first().and_then(|d| {
+                Some((
+                    *shell.node_layer.get(d.node)?,
+                    *shell.model.nodes.get(d.node)?,
+                ))
+            });
+            layers.sort_unstable();
+            layers.dedup();
+            let dofs: Vec<String> = free_dofs.iter().take(6).map(|d| d.to_string()).collect();
+            Ok(StateBuckling {
+                status: BucklingStatus::Mechanism,
+                factors: Vec::new(),
+                location: first,
+                mechanism: Some(format!(
+                    "the shell model is a mechanism in layer(s) {layers:?} (free DOFs: {})",
+                    dofs.join(", ")
+                )),
+                shell_nodes: n,
+            })
+        }
+        Err(e) => Err(DesignError::State {
+            state,
+            message: format!("buckling analysis failed: {e}"),
+        }),
+    }
+}

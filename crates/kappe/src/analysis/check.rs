@@ -1,0 +1,411 @@
+//! [`analyze`]: every print state of a cap against every constraint (σ_min, σ_max, BLF_min,
+//! l_o,max), and the constraint report (see the [module docs](super)).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::buckling::{BucklingStatus, StateBuckling, state_buckling, state_material};
+use super::options::AnalysisOptions;
+use super::stress::{ElementStress, STRESS_REL_TOL, element_stresses};
+use crate::error::DesignError;
+use crate::pipeline::Cap;
+use crate::states::build_state;
+
+/// The analysis of one print state.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StateAnalysis {
+    /// State index (0 = first layer printed).
+    pub index: usize,
+    /// Id of the top layer.
+    pub top_layer: i32,
+    /// Lowest positive buckling factor (None: not analysed, no shell or mechanism).
+    pub blf: Option<f64>,
+    /// All factors found (ascending).
+    pub blf_modes: Vec<f64>,
+    /// What the buckling analysis did.
+    pub buckling: BucklingStatus,
+    /// Most negative element normal stress, Pa (0 if none).
+    pub max_compression_stress_pa: f64,
+    /// Largest element normal stress, Pa (0 if none).
+    pub max_tension_stress_pa: f64,
+    /// Largest |l_o| over the printed layers, m.
+    pub max_overhang_m: f64,
+    /// Every checked constraint holds in this state.
+    pub ok: bool,
+    /// If the shell model is a mechanism: where.
+    pub mechanism: Option<String>,
+    /// Shell nodes (0 if none).
+    pub shell_nodes: usize,
+    /// Seconds spent on the FE model of this state (build + solve).
+    pub fe_seconds: f64,
+}
+
+/// One constraint of the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConstraintResult {
+    /// `sigma_min`, `sigma_max`, `blf_min` or `overhang_max`.
+    pub name: &'static str,
+    /// In words.
+    pub description: &'static str,
+    /// The limit.
+    pub limit: f64,
+    /// The worst value over all checked states (None if nothing was checked).
+    pub worst: Option<f64>,
+    /// State where the worst value occurs.
+    pub state: Option<usize>,
+    /// Element, layer or mode where it occurs.
+    pub element: String,
+    /// Whether the constraint holds in every checked state.
+    pub pass: bool,
+    /// Unit of `limit` and `worst`.
+    pub unit: &'static str,
+    /// States checked.
+    pub states_checked: usize,
+}
+
+/// Wall-clock split of [`analyze`], seconds (states run in parallel, so the per-state sums
+/// exceed the wall-clock phases on several cores).
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Timings {
+    /// Phase 1, wall clock: rebuilding every state, its force pass and element stresses.
+    pub stresses: f64,
+    /// Sum over states of phase 1.
+    pub stresses_sum: f64,
+    /// Phase 2, wall clock: shell models and buckling solves.
+    pub fe: f64,
+    /// Sum over states of their FE time.
+    pub fe_sum: f64,
+    /// Whole analysis.
+    pub total: f64,
+}
+
+/// The analysis of a cap: per state, the constraint report and the verdict.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Analysis {
+    /// One entry per state, in print order.
+    pub states: Vec<StateAnalysis>,
+    /// The constraint report.
+    pub constraints: Vec<ConstraintResult>,
+    /// All constraints hold.
+    pub ok: bool,
+    /// The options used.
+    pub options: AnalysisOptions,
+    /// Timings.
+    pub timings: Timings,
+}
+
+impl Analysis {
+    /// The constraints that fail.
+    pub fn failing(&self) -> impl Iterator<Item = &ConstraintResult> {
+        self.constraints.iter().filter(|c| !c.pass)
+    }
+
+    /// The report as plain text, one line per constraint.
+    pub fn report(&self) -> String {
+        let mut s = String::new();
+        for c in &self.constraints {
+            let worst = c.worst.map_or("n/a".to_string(), |w| format!("{w:.6e}"));
+            let at = c
+                .state
+                .map_or(String::new(), |st| format!(" at state {st}, {}", c.element));
+            s.push_str(&format!(
+                "{:<13} {:<4} limit {:.6e} {}, worst {worst}{at}\n",
+                c.name,
+                if c.pass { "PASS" } else { "FAIL" },
+                c.limit,
+                c.unit,
+            ));
+        }
+        s.push_str(if self.ok {
+            "design passes every constraint\n"
+        } else {
+            "design FAILS\n"
+        });
+        s
+    }
+}
+
+#[derive(Debug, Clone)]
+struct Worst {
+    value: f64,
+    state: usize,
+    element: String,
+}
+
+fn keep_min(w: &mut Option<Worst>, value: f64, state: usize, element: impl FnOnce() -> String) {
+    if w.as_ref().is_none_or(|c| value < c.value) {
+        *w = Some(Worst {
+            value,
+            state,
+            element: element(),
+        });
+    }
+}
+
+fn keep_max(w: &mut Option<Worst>, value: f64, state: usize, element: impl FnOnce() -> String) {
+    if w.as_ref().is_none_or(|c| value > c.value) {
+        *w = Some(Worst {
+            value,
+            state,
+            element: element(),
+        });
+    }
+}
+
+/// Analyse every state of `cap` (see the module docs). `on_state(n)` is called once per
+/// buckling analysis finished (for a progress bar), with the number `n` of them.
+pub fn analyze(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    on_state: &(dyn Fn(usize) + Sync),
+) -> Result<Analysis, DesignError> {
+    analyze_until(cap, options, on_state, &AtomicBool::new(false))
+}
+
+/// [`analyze`] that gives up with [`DesignError::Cancelled`] once `stop` is set (checked before
+/// every state's rebuild and buckling solve).
+pub(crate) fn analyze_until(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    on_state: &(dyn Fn(usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Analysis, DesignError> {
+    options.validate()?;
+    let cancelled = || {
+        if stop.load(Ordering::Relaxed) {
+            Err(DesignError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
+    let t_all = Instant::now();
+    let design = &cap.design;
+    let total = cap.states.len();
+    let areas = cap.areas();
+    let phi = design.print.start_arch_fraction;
+    let selected: Vec<bool> = {
+        let mut s = vec![false; total];
+        if options.buckling {
+            for i in options.states.indices(total) {
+                if let Some(x) = s.get_mut(i) {
+                    *x = true;
+                }
+            }
+        }
+        s
+    };
+
+    struct PerState {
+        stresses: Vec<ElementStress>,
+        stress_seconds: f64,
+        buckling: Option<StateBuckling>,
+        fe_seconds: f64,
+        top_layer: i32,
+    }
+    // Phase 1: every state's force pass and element stresses (cheap).
+    let t_phase = Instant::now();
+    let mut per: Vec<PerState> = (0..total)
+        .into_par_iter()
+        .map(|top| {
+            cancelled()?;
+            let t0 = Instant::now();
+            let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+            let stresses = element_stresses(&state, areas)?;
+            Ok(PerState {
+                stresses,
+                stress_seconds: t0.elapsed().as_secs_f64(),
+                buckling: None,
+                fe_seconds: 0.0,
+                top_layer: state.top_layer,
+            })
+        })
+        .collect::<Result<_, DesignError>>()?;
+    let wall_stresses = t_phase.elapsed().as_secs_f64();
+    // Phase 2: the buckling analysis of the selected states, largest first so the two cores
+    // finish together.
+    let t_phase = Instant::now();
+    let mut order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
+    order.reverse();
+    let n_fe = order.len();
+    let fe: Vec<(usize, StateBuckling, f64)> = order
+        .into_par_iter()
+        .map(|top| {
+            cancelled()?;
+            let t0 = Instant::now();
+            let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+            let mat = state_material(cap, options, top);
+            let b = state_buckling(&state, &mat, options)?;
+            on_state(n_fe);
+            Ok((top, b, t0.elapsed().as_secs_f64()))
+        })
+        .collect::<Result<_, DesignError>>()?;
+    let wall_fe = t_phase.elapsed().as_secs_f64();
+    for (top, b, secs) in fe {
+        if let Some(p) = per.get_mut(top) {
+            p.buckling = Some(b);
+            p.fe_seconds = secs;
+        }
+    }
+
+    // Overhangs: |l_o| of each layer, in print order.
+    let overhang_of = |q: usize| cap.overhangs.get(q).map_or(0.0, |o| o.abs());
+    let lo_max = design.overhang_max();
+    let (sigma_min, sigma_max, blf_min) = (
+        design.constraints.sigma_min,
+        design.constraints.sigma_max,
+        design.constraints.blf_min,
+    );
+    let stress_scale = per
+        .iter()
+        .flat_map(|p| p.stresses.iter())
+        .fold(0.0_f64, |m, s| m.max(s.stress.abs()));
+    let stol = STRESS_REL_TOL * stress_scale;
+
+    let mut w_comp: Option<Worst> = None;
+    let mut w_tens: Option<Worst> = None;
+    let mut w_blf: Option<Worst> = None;
+    let mut w_lo: Option<Worst> = None;
+    let mut blf_checked = 0;
+    let mut states = Vec::with_capacity(total);
+    let mut running_lo: f64 = 0.0;
+    let (mut t_stress, mut t_fe) = (0.0, 0.0);
+    for (q, p) in per.iter().enumerate() {
+        t_stress += p.stress_seconds;
+        t_fe += p.fe_seconds;
+        let mut smin: f64 = 0.0;
+        let mut smax: f64 = 0.0;
+        for s in &p.stresses {
+            smin = smin.min(s.stress);
+            smax = smax.max(s.stress);
+            keep_min(&mut w_comp, s.stress, q, || s.kind.to_string());
+            keep_max(&mut w_tens, s.stress, q, || s.kind.to_string());
+        }
+        let lo = overhang_of(q);
+        let layer_id = cap.sections.layers.get(q).map_or(0, |l| l.id);
+        keep_max(&mut w_lo, lo, q, || format!("layer {layer_id}"));
+        running_lo = running_lo.max(lo);
+        let mut ok = smin >= sigma_min - stol && smax <= sigma_max + stol && running_lo <= lo_max;
+        let (mut blf, mut modes, mut status, mut mechanism, mut nodes) =
+            (None, Vec::new(), BucklingStatus::Skipped, None, 0);
+        if let Some(b) = &p.buckling {
+            status = b.status;
+            modes = b.factors.clone();
+            blf = b.factors.first().copied();
+            mechanism = b.mechanism.clone();
+            nodes = b.shell_nodes;
+            let place = || match b.location {
+                Some((layer, x)) => format!(
+                    "mode 1 peaks in layer {layer} at ({:.3}, {:.3}, {:.3}) m",
+                    x[0], x[1], x[2]
+                ),
+                None => "mode 1".to_string(),
+            };
+            match b.status {
+                BucklingStatus::Analysed => {
+                    blf_checked += 1;
+                    if let Some(f) = blf {
+                        ok &= f >= blf_min;
+                        keep_min(&mut w_blf, f, q, place);
+                    }
+                }
+                BucklingStatus::Mechanism => {
+                    blf_checked += 1;
+                    ok = false;
+                    let m = mechanism.clone().unwrap_or_default();
+                    keep_min(&mut w_blf, 0.0, q, || m);
+                }
+                _ => {}
+            }
+        }
+        states.push(StateAnalysis {
+            index: q,
+            top_layer: p.top_layer,
+            blf,
+            blf_modes: modes,
+            buckling: status,
+            max_compression_stress_pa: smin,
+            max_tension_stress_pa: smax,
+            max_overhang_m: running_lo,
+            ok,
+            mechanism,
+            shell_nodes: nodes,
+            fe_seconds: p.fe_seconds,
+        });
+    }
+
+    let result = |name: &'static str,
+                  description: &'static str,
+                  unit: &'static str,
+                  limit: f64,
+                  w: Option<Worst>,
+                  checked: usize,
+                  pass: &dyn Fn(f64) -> bool| {
+        let pass_v = w.as_ref().is_none_or(|w| pass(w.value));
+        ConstraintResult {
+            name,
+            description,
+            limit,
+            worst: w.as_ref().map(|w| w.value),
+            state: w.as_ref().map(|w| w.state),
+            element: w.map(|w| w.element).unwrap_or_default(),
+            pass: pass_v,
+            unit,
+            states_checked: checked,
+        }
+    };
+    let constraints = vec![
+        result(
+            "sigma_min",
+            "compressive stress: σ ≥ σ_min in every element",
+            "Pa",
+            sigma_min,
+            w_comp,
+            total,
+            &|v| v >= sigma_min - stol,
+        ),
+        result(
+            "sigma_max",
+            "tensile stress: σ ≤ σ_max in every element",
+            "Pa",
+            sigma_max,
+            w_tens,
+            total,
+            &|v| v <= sigma_max + stol,
+        ),
+        result(
+            "blf_min",
+            "buckling: BLF ≥ BLF_min in every analysed state",
+            "1",
+            blf_min,
+            w_blf,
+            blf_checked,
+            &|v| v >= blf_min,
+        ),
+        result(
+            "overhang_max",
+            "layer overhang: |l_o| ≤ l_o,max for every layer",
+            "m",
+            lo_max,
+            w_lo,
+            total,
+            &|v| v <= lo_max,
+        ),
+    ];
+    let ok = constraints.iter().all(|c| c.pass);
+    Ok(Analysis {
+        states,
+        constraints,
+        ok,
+        options: options.clone(),
+        timings: Timings {
+            stresses: wall_stresses,
+            stresses_sum: t_stress,
+            fe: wall_fe,
+            fe_sum: t_fe,
+            total: t_all.elapsed().as_secs_f64(),
+        },
+    })
+}

@@ -1,0 +1,43 @@
+//! Analysis of every print state against the structural constraints of method.md §3, and the
+//! constraint report (the paper's design loop, Figure 3: "analyse every state globally and
+//! locally").
+//!
+//! Per state:
+//! - **Stresses.** Every element's normal stress σ = N / A (compression negative), with
+//!   A = lw·lh for arch segments (along a layer) and A = lw·l_trib for the bed joints between
+//!   layers (the column edges), from CEM's fixed-geometry force pass over the constructed
+//!   network ([`crate::forces`]). Checked against σ_min ≤ σ ≤ σ_max.
+//! - **Overhang.** |l_o| of every printed layer over the preceding one
+//!   ([`overhang::layer_overhangs`]) against l_o,max.
+//! - **Buckling.** The lowest positive linear buckling factor of the state's shell model
+//!   ([`crate::shell`], `kappe_fe`) under self-weight, against BLF_min. A state whose shell
+//!   model is a mechanism is reported with the layer where the free motion sits.
+//!
+//! The report ([`ConstraintResult`]) gives for each constraint its limit, the worst value over all
+//! states, where it occurs (state and element) and pass/fail; the design passes only if all hold.
+//!
+//! Stresses and overhangs are cheap and always checked in every state; [`StateSelection`] thins
+//! out only the buckling analysis (the final state is always included, as it carries the most
+//! load). States are analysed in parallel (rayon) and reported in print order.
+//!
+//! Tolerances: a stress passes if it is within `1e-9·max|σ|` of its limit (the relative size of
+//! the force pass's residuals, method.md §9), so that σ_max = 0 is not failed by round-off.
+//!
+//! The modules follow the analysis: [`options`] (what to analyse), [`overhang`] (layer overhang,
+//! computed during form-finding), [`stress`] (element normal stresses), [`ageing`] (the
+//! green material's modulus by layer age), [`buckling`] (the shell buckling run of one state)
+//! and [`check`] ([`analyze`]: every state against every constraint, and the report).
+
+pub mod ageing;
+pub mod buckling;
+pub mod check;
+pub mod options;
+pub mod overhang;
+pub mod stress;
+
+pub use ageing::Ageing;
+pub use buckling::{BucklingStatus, StateBuckling, shell_buckling, state_buckling, state_material};
+pub use check::{Analysis, ConstraintResult, StateAnalysis, Timings, analyze};
+pub use options::{AnalysisOptions, SelectionError, StateSelection};
+pub use overhang::layer_overhangs;
+pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};

@@ -1,0 +1,270 @@
+//! The whole pipeline of one design: form-finding ([`crate::design_cap`]), then the analysis of
+//! every state ([`crate::analysis::analyze`], when asked for), the robot plan
+//! ([`crate::robot_plan::plan_robot`], when asked for), the verdict ([`crate::verdict`]), the
+//! summary (`summary.json`) and the report input ([`crate::report_input`]).
+//!
+//! [`run`] is what `kappe design`, every design of `kappe study` and the Python `kappe.design`
+//! call, so their numbers and verdicts cannot disagree. [`evaluate`] is the part after
+//! form-finding, for callers that already hold a [`Cap`].
+
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use crate::analysis::{Analysis, AnalysisOptions};
+use crate::error::DesignError;
+use crate::pipeline::Cap;
+use crate::report_input::{ReportExtras, add_robot, extras_from_analysis, report_input};
+use crate::spec::Design;
+
+/// What [`run`] does after form-finding.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Options {
+    /// The analysis of every state (stresses, overhang, shell buckling); `None`: no analysis,
+    /// the verdict is then the preliminary one of [`crate::verdict::design_ok`].
+    pub analysis: Option<AnalysisOptions>,
+    /// Plan the robot, for designs whose `robot.enabled` is set.
+    pub robot: bool,
+}
+
+impl Options {
+    /// What `kappe design` does by default: the design's own `[analysis]` options (buckling on
+    /// unless the file says otherwise) and the robot plan.
+    pub fn of(design: &Design) -> Options {
+        Options {
+            analysis: Some(design.analysis.clone()),
+            robot: true,
+        }
+    }
+}
+
+/// A stage of [`run`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Form-finding and the force pass of every print state.
+    States,
+    /// The buckling analysis of the selected states (one tick per finite-element solve).
+    Analysis,
+    /// Robot planning (one tick with `done = 0` when it starts, one with `done = 1` at the end).
+    Robot,
+}
+
+/// One progress report of [`run`]: `done` of `total` steps of `stage` are finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Progress {
+    /// The stage.
+    pub stage: Stage,
+    /// Steps finished.
+    pub done: usize,
+    /// Steps of the stage.
+    pub total: usize,
+}
+
+/// A progress callback: called from worker threads; [`ControlFlow::Break`] stops the run (it then
+/// returns [`DesignError::Cancelled`]).
+pub type OnProgress<'a> = &'a (dyn Fn(Progress) -> ControlFlow<()> + Sync);
+
+/// A progress callback that reports nowhere and never stops.
+pub fn no_progress(_: Progress) -> ControlFlow<()> {
+    ControlFlow::Continue(())
+}
+
+/// Counts the ticks of one stage and remembers a request to stop.
+struct Ticker<'a> {
+    on_progress: OnProgress<'a>,
+    stop: &'a AtomicBool,
+    done: AtomicUsize,
+    stage: Stage,
+}
+
+impl<'a> Ticker<'a> {
+    fn new(on_progress: OnProgress<'a>, stop: &'a AtomicBool, stage: Stage) -> Self {
+        Ticker {
+            on_progress,
+            stop,
+            done: AtomicUsize::new(0),
+            stage,
+        }
+    }
+
+    fn tick(&self, total: usize) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        self.report(done, total);
+    }
+
+    fn report(&self, done: usize, total: usize) {
+        let p = Progress {
+            stage: self.stage,
+            done,
+            total,
+        };
+        if (self.on_progress)(p).is_break() {
+            self.stop.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+fn check(stop: &AtomicBool) -> Result<(), DesignError> {
+    if stop.load(Ordering::Relaxed) {
+        Err(DesignError::Cancelled)
+    } else {
+        Ok(())
+    }
+}
+
+/// Everything [`run`] found for one design.
+#[derive(Debug)]
+pub struct Outcome {
+    /// The designed cap: every state, the layers, the print path, the mesh.
+    pub cap: Cap,
+    /// Stresses, overhang and buckling of every state, and the constraint report; `None` when
+    /// not asked for.
+    pub analysis: Option<Analysis>,
+    /// The robot plan, or why there is none; `None` when planning was not asked for (or the
+    /// design disables the robot).
+    pub robot: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The analysis and robot results in report form.
+    pub extras: ReportExtras,
+    /// The verdict of [`crate::verdict::design_ok`].
+    pub ok: bool,
+}
+
+/// Form-find `design`, then [`evaluate`] it. `on_progress` hears every state solved, every
+/// buckling solve and the robot planning; it may stop the run.
+///
+/// # Errors
+/// An invalid design or invalid analysis options ([`DesignError::Invalid`]), a design without an
+/// equilibrium form, a state that cannot be built, or [`DesignError::Cancelled`].
+pub fn run(
+    design: &Design,
+    options: &Options,
+    on_progress: OnProgress<'_>,
+) -> Result<Outcome, DesignError> {
+    let stop = AtomicBool::new(false);
+    let states = Ticker::new(on_progress, &stop, Stage::States);
+    let cap = crate::pipeline::design_cap_until(design, &|total| states.tick(total), &stop)?;
+    check(&stop)?;
+    evaluate_until(cap, options, on_progress, &stop)
+}
+
+/// The pipeline after form-finding (see [`run`]): analysis, robot plan, verdict.
+///
+/// # Errors
+/// As [`run`], without the form-finding ones.
+pub fn evaluate(
+    cap: Cap,
+    options: &Options,
+    on_progress: OnProgress<'_>,
+) -> Result<Outcome, DesignError> {
+    evaluate_until(cap, options, on_progress, &AtomicBool::new(false))
+}
+
+fn evaluate_until(
+    cap: Cap,
+    options: &Options,
+    on_progress: OnProgress<'_>,
+    stop: &AtomicBool,
+) -> Result<Outcome, DesignError> {
+    let fe = Ticker::new(on_progress, stop, Stage::Analysis);
+    let analysis = match &options.analysis {
+        Some(o) => Some(crate::analysis::check::analyze_until(
+            &cap,
+            o,
+            &|total| fe.tick(total),
+            stop,
+        )?),
+        None => None,
+    };
+    check(stop)?;
+    let mut extras = analysis
+        .as_ref()
+        .map(extras_from_analysis)
+        .unwrap_or_default();
+    let robot = if options.robot && cap.design.robot.enabled {
+        let ticker = Ticker::new(on_progress, stop, Stage::Robot);
+        ticker.report(0, 1);
+        check(stop)?;
+        let plan = crate::robot_plan::plan_robot(&cap);
+        ticker.report(1, 1);
+        Some(plan)
+    } else {
+        None
+    };
+    if let Some(plan) = &robot {
+        add_robot(&mut extras, plan);
+    }
+    let ok = crate::verdict::design_ok(&cap, &extras);
+    Ok(Outcome {
+        cap,
+        analysis,
+        robot,
+        extras,
+        ok,
+    })
+}
+
+impl Outcome {
+    /// `summary.json`: the cap's summary with the analysis merged in, the robot block
+    /// (stations with `world_from_base`, `flange_from_tcp`, motion, time, clearance; or why it
+    /// failed) and the verdict `ok`.
+    pub fn summary(&self) -> serde_json::Value {
+        let cap = &self.cap;
+        let mut summary = crate::export::summary_json(cap);
+        if let Some(analysis) = &self.analysis {
+            crate::export::add_analysis(&mut summary, analysis);
+        }
+        let robot = match &self.robot {
+            None => serde_json::json!({"planned": false, "reason": "disabled"}),
+            Some(Ok(plan)) => plan_summary(plan),
+            Some(Err(e)) => {
+                serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
+            }
+        };
+        if let Some(obj) = summary.as_object_mut() {
+            obj.insert("robot".into(), robot);
+            obj.insert("ok".into(), serde_json::json!(self.ok));
+        }
+        summary
+    }
+
+    /// The input of the HTML report ([`crate::report_input::report_input`]).
+    pub fn report_input(&self) -> kappe_report::ReportInput {
+        report_input(&self.cap, &self.extras)
+    }
+
+    /// The HTML report.
+    ///
+    /// # Errors
+    /// What [`kappe_report::render_html`] rejects (a report input that does not validate).
+    pub fn report_html(&self) -> Result<String, kappe_report::ReportError> {
+        kappe_report::render_html(&self.report_input())
+    }
+
+    /// The lowest buckling factor over the analysed states, if any.
+    pub fn min_blf(&self) -> Option<f64> {
+        self.extras
+            .states
+            .iter()
+            .filter_map(|s| s.blf)
+            .fold(None, |m: Option<f64>, b| Some(m.map_or(b, |m| m.min(b))))
+    }
+}
+
+/// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
+fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
+    serde_json::json!({
+        "planned": true,
+        "ok": true,
+        "stations": plan.stations.iter().map(|s| serde_json::json!({
+            "world_from_base": s.world_from_base,
+            "layers": s.layers.iter().map(|l| l.layer).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+        "flange_from_tcp": plan.flange_from_tcp,
+        "joint_motion_rad": plan.joint_motion,
+        "cost_rad2": plan.cost,
+        "print_time_s": plan.print_time,
+        "total_time_s": plan.total_time,
+        "min_clearance_m": plan.min_clearance,
+        "min_self_distance_m": plan.min_self_distance,
+        "max_speed_ratio": plan.max_speed_ratio,
+    })
+}

@@ -1,0 +1,500 @@
+//! From a designed cap to the HTML report input (issue 8).
+//!
+//! [`report_input`] maps a [`Cap`] plus optional analysis and robot results
+//! ([`ReportExtras`], plain data filled by [`crate::evaluate`]) to [`kappe_report::ReportInput`]:
+//!
+//! - `layers`: `cap.sections.layers` in print order; the final-state stress of segment `i` of the
+//!   layer at print index `q` is `σ = F_i · d_q / (lw·lh)` (method.md §3, §6: `F_i` the layer-0
+//!   force, `d_q` the layer factor of the final state); overhang `l_o` from `cap.overhangs`
+//!   (`None` for the first layer).
+//! - `bed_joints`: the final state's trail edges, `σ = N / (lw·l_trib)` with the trail forces of
+//!   the final force pass, drawn from the lower node to the upper one; a column's last edge ends
+//!   on the base plane.
+//! - `states`: one per `cap.states`, with σ_min/σ_max of the force pass, the largest |l_o| of the
+//!   printed layers and, while the page stays small, per-state segment stresses
+//!   `F_i · d_q(state) / (lw·lh)` (the factors of every state, kept by `design_cap`; they
+//!   differ from the final ones only in the start section).
+//! - `constraints`: [`preliminary_constraints`] (σ_min, σ_max, overhang, worst over all states),
+//!   then the analysis rows of [`ReportExtras::constraints`], which replace rows of the same
+//!   name and add new ones (BLF, robot reach, …).
+
+use kappe_report::{
+    BedJoint, Bound, ConstraintRow, Layer, Parameter, Plot, PrintPath, PrintState, ReportInput,
+    RobotAnimation,
+};
+
+use crate::pipeline::Cap;
+use crate::verdict::{
+    max_overhang, preliminary_constraints, state_ok_preliminary, stress_tolerance,
+};
+
+/// Above this many per-state segment stresses in total, the states carry none and the viewer
+/// colours every state by the final-state stresses: the page grows by ~10 bytes per value,
+/// so this bounds the island at ~20 MB (the default design needs ~0.3 million).
+const MAX_STATE_STRESS_VALUES: usize = 2_000_000;
+
+/// Results of one print state from the analysis ([`crate::analysis::analyze`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StateCheck {
+    /// Lowest positive linear buckling load factor of the state, if computed.
+    pub blf: Option<f64>,
+    /// Whether the state meets every structural constraint.
+    pub ok: bool,
+}
+
+/// What the analysis and the robot planner add to a designed cap. Plain data: the caller fills
+/// it; [`ReportExtras::default`] means "not analysed, no robot".
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ReportExtras {
+    /// One entry per `cap.states` (same order), or empty when there is no analysis. An entry's
+    /// `ok` replaces the preliminary per-state verdict; its `blf` feeds the BLF plot.
+    pub states: Vec<StateCheck>,
+    /// Constraint rows of the analysis (worst over all states). A row replaces the preliminary
+    /// row of the same `name` (`sigma_min`, `sigma_max`, `overhang_max`); other rows (`blf_min`,
+    /// robot checks) are appended.
+    pub constraints: Vec<ConstraintRow>,
+    /// The analysis verdict over all constraints; `None` until the analysis exists.
+    pub ok: Option<bool>,
+    /// The robot moving along its trajectory.
+    pub robot: Option<RobotAnimation>,
+    /// Why the robot cannot print the design, if planning was tried and failed (the design then
+    /// fails, as `kappe design` exits non-zero for it).
+    pub robot_error: Option<String>,
+    /// Extra plots after the standard ones.
+    pub plots: Vec<Plot>,
+}
+
+/// The analysis of `crate::analysis::analyze` as report extras: per-state BLF and verdict,
+/// the constraint rows in the report's units (stresses in kPa, overhang in mm; the analysis
+/// gives Pa and m), and the overall verdict. A constraint that no state was checked for (e.g.
+/// `blf_min` with buckling switched off) has no worst value and is left out of the table.
+pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtras {
+    let states = analysis
+        .states
+        .iter()
+        .map(|s| StateCheck {
+            blf: s.blf,
+            ok: s.ok,
+        })
+        .collect();
+    let constraints = analysis
+        .constraints
+        .iter()
+        .filter_map(|c| {
+            let worst = c.worst?;
+            let (scale, unit) = match c.unit {
+                "Pa" => (1e-3, "kPa"),
+                "m" => (1e3, "mm"),
+                "1" => (1.0, ""),
+                other => (1.0, other),
+            };
+            let bound = match c.name {
+                "sigma_max" | "overhang_max" => Bound::AtMost,
+                _ => Bound::AtLeast,
+            };
+            Some(ConstraintRow {
+                name: c.name.to_string(),
+                bound,
+                limit: c.limit * scale,
+                worst: worst * scale,
+                unit: unit.to_string(),
+                state: c.state,
+                element: (!c.element.is_empty()).then(|| c.element.clone()),
+                pass: c.pass,
+            })
+        })
+        .collect();
+    ReportExtras {
+        states,
+        constraints,
+        ok: Some(analysis.ok),
+        ..ReportExtras::default()
+    }
+}
+
+/// Frames of the robot animation embedded in the report, spread evenly over the plan: every
+/// waypoint would make the page large (~1 kB per frame for the 13 capsules of arm and tool).
+pub const ROBOT_FRAMES: usize = 600;
+
+/// The arm posed along the robot plan (`crate::robot_plan::arm_frames`) as the report's
+/// animation.
+pub fn robot_animation(frames: &crate::robot_plan::ArmFrames) -> RobotAnimation {
+    RobotAnimation {
+        times: frames.times.clone(),
+        joints: frames.joints.clone(),
+        link_radii: frames.radii.clone(),
+        poses: frames.segments.clone(),
+        ..RobotAnimation::default()
+    }
+}
+
+/// Adds the outcome of robot planning (`crate::robot_plan::plan_robot`): for a plan, the
+/// animation ([`ROBOT_FRAMES`] frames) and a passing `robot_plan` row whose element tells the
+/// stations and the minimum clearance; for a failure, [`ReportExtras::robot_error`] and a
+/// failing row whose element is the planner's reason.
+pub fn add_robot(
+    extras: &mut ReportExtras,
+    plan: &Result<kappe_robot::Plan, kappe_robot::RobotError>,
+) {
+    let (pass, element) = match plan {
+        Ok(p) => {
+            // A plan that cannot be posed for the animation is still a valid plan: the page then
+            // shows no robot, and the verdict does not change.
+            extras.robot = crate::robot_plan::arm_frames(p, &p.setup.tool, ROBOT_FRAMES)
+                .ok()
+                .map(|f| robot_animation(&f));
+            (
+                true,
+                format!(
+                    "{} station(s), min clearance {:.1} mm, {:.1} min",
+                    p.stations.len(),
+                    p.min_clearance * 1e3,
+                    p.total_time / 60.0
+                ),
+            )
+        }
+        Err(e) => {
+            extras.robot_error = Some(e.to_string());
+            (false, e.to_string())
+        }
+    };
+    extras.constraints.push(ConstraintRow {
+        name: "robot_plan".into(),
+        bound: Bound::AtMost,
+        limit: 0.0,
+        worst: if pass { 0.0 } else { 1.0 },
+        unit: "failures".into(),
+        state: None,
+        element: Some(element),
+        pass,
+    });
+}
+
+/// The constraint table: preliminary rows, replaced or extended by the analysis rows.
+fn constraint_rows(cap: &Cap, extras: &ReportExtras) -> Vec<ConstraintRow> {
+    let mut rows = preliminary_constraints(cap);
+    for row in &extras.constraints {
+        match rows.iter_mut().find(|r| r.name == row.name) {
+            Some(slot) => *slot = row.clone(),
+            None => rows.push(row.clone()),
+        }
+    }
+    rows
+}
+
+fn v3(v: &crate::frame::V3) -> [f64; 3] {
+    [v.x, v.y, v.z]
+}
+
+fn parameters(cap: &Cap) -> Vec<Parameter> {
+    let d = &cap.design;
+    let p = |key: &str, value: String, unit: &str| Parameter {
+        key: key.into(),
+        value,
+        unit: unit.into(),
+    };
+    let mut out = vec![
+        p("span Cs", format!("{}", d.cap.span), "m"),
+        p("rise Cr", format!("{}", d.cap.rise), "m"),
+        p("length Cl", format!("{}", d.cap.length), "m"),
+        p("layer tilt am", format!("{}", d.cap.tilt_deg), "deg"),
+        p(
+            "specific weight γ",
+            format!("{}", d.material.specific_weight),
+            "N/m³",
+        ),
+        p(
+            "Young's modulus E",
+            format!("{}", d.material.youngs_modulus / 1e6),
+            "MPa",
+        ),
+        p(
+            "Poisson's ratio ν",
+            format!("{}", d.material.poisson_ratio),
+            "",
+        ),
+        p(
+            "layer height lh",
+            format!("{}", d.print.layer_height * 1e3),
+            "mm",
+        ),
+        p(
+            "layer width lw",
+            format!("{}", d.print.layer_width * 1e3),
+            "mm",
+        ),
+        p(
+            "nozzle diameter d_n",
+            format!("{}", d.print.nozzle_diameter * 1e3),
+            "mm",
+        ),
+        p(
+            "path sampling Δs",
+            format!("{}", d.print.path_sampling * 1e3),
+            "mm",
+        ),
+        p(
+            "start-layer arch fraction φ",
+            format!("{}", d.print.start_arch_fraction),
+            "",
+        ),
+        p("print speed", format!("{}", d.print.print_speed), "m/s"),
+        p("σ_min", format!("{}", d.constraints.sigma_min / 1e3), "kPa"),
+        p("σ_max", format!("{}", d.constraints.sigma_max / 1e3), "kPa"),
+        p("BLF_min", format!("{}", d.constraints.blf_min), ""),
+        p("l_o,max", format!("{}", d.overhang_max() * 1e3), "mm"),
+    ];
+    out.extend([
+        p("centre layers N", format!("{}", cap.sections.n_centre), ""),
+        p("start layers K", format!("{}", cap.sections.n_start), ""),
+        p("catenary a", format!("{:.6}", cap.catenary.a), "m"),
+        p("mass", format!("{:.2}", cap.path.mass), "kg"),
+        p("print time", format!("{:.1}", cap.path.time / 60.0), "min"),
+    ]);
+    out
+}
+
+/// Per-state segment stresses: the printed layers' segments, concatenated in print order, with
+/// that state's layer factors (kept by `design_cap`). `None` when the total is too large.
+fn state_segment_stresses(cap: &Cap, area: f64) -> Option<Vec<Vec<f64>>> {
+    let seg_counts: Vec<usize> = cap
+        .sections
+        .layers
+        .iter()
+        .map(|l| l.segment_forces.len())
+        .collect();
+    let total: usize = cap
+        .states
+        .iter()
+        .map(|s| seg_counts.iter().take(s.layers_printed).sum::<usize>())
+        .sum();
+    if total > MAX_STATE_STRESS_VALUES {
+        return None;
+    }
+    let per_state = cap
+        .states
+        .iter()
+        .map(|s| {
+            let mut out = Vec::new();
+            for (layer, d) in cap.sections.layers.iter().zip(&s.factors) {
+                out.extend(layer.segment_forces.iter().map(|f| f * d / area));
+            }
+            out
+        })
+        .collect();
+    Some(per_state)
+}
+
+/// Maps a designed cap (plus optional analysis and robot results) to the report input.
+/// See the module docs for the mapping.
+pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
+    let d = &cap.design;
+    let areas = cap.areas();
+    let normal = v3(&cap.frame.n);
+    let final_factors = &cap.final_state.factors;
+
+    let layers: Vec<Layer> = cap
+        .sections
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(q, l)| {
+            let factor = final_factors.get(q).copied().unwrap_or(1.0);
+            Layer {
+                id: l.id,
+                nodes: l.nodes.iter().map(|n| v3(&n.xyz)).collect(),
+                segment_stress: l
+                    .segment_forces
+                    .iter()
+                    .map(|f| f * factor / areas.along_layer)
+                    .collect(),
+                plane_normal: normal,
+                bead_width: d.print.layer_width,
+                bead_height: d.print.layer_height,
+                overhang: if q == 0 {
+                    None
+                } else {
+                    cap.overhangs.get(q).copied()
+                },
+            }
+        })
+        .collect();
+
+    // Trails run from the top layer down to the base: `u` is the upper node, `v` the lower.
+    let net = &cap.final_state.network;
+    let bed_joints: Vec<BedJoint> = cap
+        .final_topology
+        .trail_edges
+        .iter()
+        .zip(&cap.final_forces.trail_forces)
+        .filter_map(|(e, f)| {
+            let upper = net.nodes.get(usize::try_from(e.u).ok()?)?;
+            let lower = net.nodes.get(usize::try_from(e.v).ok()?)?;
+            Some(BedJoint {
+                layer: upper.layer,
+                a: v3(&lower.xyz),
+                b: v3(&upper.xyz),
+                stress: f / areas.bed_joint,
+            })
+        })
+        .collect();
+
+    let print_path = PrintPath {
+        points: cap.path.points.iter().map(|p| v3(&p.tip)).collect(),
+        tool_axis: cap.path.points.iter().map(|p| v3(&p.axis)).collect(),
+        layer: cap.path.points.iter().map(|p| p.layer).collect(),
+    };
+
+    let tol = stress_tolerance(cap);
+    let mut per_state = state_segment_stresses(cap, areas.along_layer);
+    let states: Vec<PrintState> = cap
+        .states
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let check = extras.states.get(i);
+            PrintState {
+                index: s.index,
+                progress: s.progress.clamp(0.0, 1.0),
+                layers_printed: s.layers_printed,
+                blf: check.and_then(|c| c.blf),
+                sigma_min: s.forces.max_compression_stress,
+                sigma_max: s.forces.max_tension_stress,
+                max_overhang: max_overhang(cap, s.layers_printed),
+                ok: check.map_or_else(|| state_ok_preliminary(cap, s, tol), |c| c.ok),
+                segment_stress: per_state
+                    .as_mut()
+                    .and_then(|v| v.get_mut(i))
+                    .map(std::mem::take),
+            }
+        })
+        .collect();
+
+    ReportInput {
+        name: d.name.clone(),
+        parameters: parameters(cap),
+        layers,
+        bed_joints,
+        print_path,
+        states,
+        constraints: constraint_rows(cap, extras),
+        robot: extras.robot.clone(),
+        plots: extras.plots.clone(),
+        ..ReportInput::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::verdict::design_ok;
+
+    fn cheap_cap() -> Cap {
+        // 3 centre layers and lh = 15 mm: a few start layers, a fast design.
+        let design =
+            crate::Design::from_toml_str("[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n")
+                .unwrap();
+        crate::design_cap(&design, &|_| {}).unwrap()
+    }
+
+    #[test]
+    fn input_validates_and_matches_the_cap() {
+        let cap = cheap_cap();
+        let input = report_input(&cap, &ReportExtras::default());
+        input.validate().unwrap();
+        assert_eq!(input.layers.len(), cap.sections.layers.len());
+        assert_eq!(input.states.len(), cap.states.len());
+        assert_eq!(input.print_path.points.len(), cap.path.points.len());
+        assert_eq!(input.bed_joints.len(), cap.final_topology.trail_edges.len());
+        // The last state is the final state: its per-state stresses equal the layers' ones.
+        let last = input.states.last().unwrap();
+        let from_layers: Vec<f64> = input
+            .layers
+            .iter()
+            .flat_map(|l| l.segment_stress.iter().copied())
+            .collect();
+        assert_eq!(last.segment_stress.as_deref(), Some(from_layers.as_slice()));
+        // The most compressive arch stress of the final state cannot be below the state's
+        // σ_min, which also covers the bed joints.
+        let min_arch = from_layers.iter().copied().fold(0.0, f64::min);
+        assert!(min_arch >= last.sigma_min);
+    }
+
+    #[test]
+    fn analysis_rows_replace_and_extend() {
+        let cap = cheap_cap();
+        let extras = ReportExtras {
+            states: vec![
+                StateCheck {
+                    blf: Some(3.0),
+                    ok: true
+                };
+                cap.states.len()
+            ],
+            constraints: vec![ConstraintRow {
+                name: "blf".into(),
+                bound: Bound::AtLeast,
+                limit: 1.0,
+                worst: 3.0,
+                unit: String::new(),
+                state: Some(0),
+                element: None,
+                pass: true,
+            }],
+            ok: Some(false),
+            ..ReportExtras::default()
+        };
+        let input = report_input(&cap, &extras);
+        let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["sigma_min", "sigma_max", "overhang_max", "blf"]);
+        assert!(input.states.iter().all(|s| s.blf == Some(3.0) && s.ok));
+        // The analysis verdict wins over the preliminary one.
+        assert!(!design_ok(&cap, &extras));
+    }
+
+    #[test]
+    fn the_analysis_replaces_the_preliminary_rows_and_agrees_with_them() {
+        let cap = cheap_cap();
+        let options = crate::analysis::AnalysisOptions {
+            // Stresses and overhang only: the FE buckling solve is tested in crates/kappe.
+            buckling: false,
+            ..Default::default()
+        };
+        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let extras = extras_from_analysis(&analysis);
+        assert_eq!(extras.states.len(), cap.states.len());
+        let input = report_input(&cap, &extras);
+        input.validate().unwrap();
+        // blf_min was checked in no state, so it has no row; the other three replace the
+        // preliminary rows and must agree with them in verdict, limit and worst value.
+        let pre = preliminary_constraints(&cap);
+        assert_eq!(input.constraints.len(), pre.len());
+        for (a, p) in input.constraints.iter().zip(&pre) {
+            assert_eq!(
+                (a.name.as_str(), a.pass, a.bound),
+                (p.name.as_str(), p.pass, p.bound)
+            );
+            assert_eq!(a.unit, p.unit);
+            assert!(
+                (a.limit - p.limit).abs() <= 1e-12 * p.limit.abs().max(1.0),
+                "{a:?} {p:?}"
+            );
+            // Both take the extreme over all states of the same force pass: equal to roundoff.
+            assert!(
+                (a.worst - p.worst).abs() <= 1e-9 * p.worst.abs().max(1e-6),
+                "{a:?} {p:?}"
+            );
+        }
+        assert_eq!(
+            design_ok(&cap, &extras),
+            design_ok(&cap, &ReportExtras::default())
+        );
+        for (s, p) in input
+            .states
+            .iter()
+            .zip(&report_input(&cap, &ReportExtras::default()).states)
+        {
+            assert_eq!(s.ok, p.ok, "state {}", s.index);
+        }
+    }
+}

@@ -1,0 +1,161 @@
+//! Running the designs of a study: one design at a time ([`run_one`], no I/O: the caller writes
+//! the files it returns), and the rows collected into a [`StudyResult`] ([`collect`]).
+
+use std::panic::AssertUnwindSafe;
+
+use super::file::{get_path, show};
+use super::{RESULT_FORMAT, Record, Study, StudyError, StudyResult, Variation, Verdict};
+use crate::evaluate::{Options, no_progress};
+
+/// What one design of a study produced: its row and, if it ran, its files.
+#[derive(Debug, Clone)]
+pub struct DesignRun {
+    /// The row of `study.csv` / `study.json`.
+    pub record: Record,
+    /// `designs/<name>/summary.json` (the same as `kappe design` writes), if the design ran.
+    pub summary: Option<serde_json::Value>,
+    /// `designs/<name>/report.html`, if the design ran.
+    pub report_html: Option<String>,
+}
+
+/// The value of each varied parameter of `v`, as text: the override, else the resolved
+/// design's own value.
+pub fn parameter_values(v: &Variation, parameter_paths: &[String]) -> Vec<String> {
+    parameter_paths
+        .iter()
+        .map(|p| {
+            get_path(&v.table, p)
+                .map(show)
+                .or_else(|| {
+                    v.design.as_ref().ok().and_then(|d| {
+                        d.to_toml_string()
+                            .parse::<toml::Table>()
+                            .ok()
+                            .and_then(|t| get_path(&t, p).map(show))
+                    })
+                })
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
+/// The row of a design that could not be run, with the reason.
+pub fn error_record(v: &Variation, parameters: Vec<String>, reason: String) -> Record {
+    Record {
+        index: v.index,
+        name: v.name.clone(),
+        parameters,
+        outcome: Verdict::Error,
+        error: Some(reason),
+        max_compression_stress_pa: None,
+        max_tension_stress_pa: None,
+        max_overhang_m: None,
+        min_blf: None,
+        mass_kg: None,
+        print_time_s: None,
+        states: None,
+        robot: None,
+        constraints: Vec::new(),
+        report: None,
+    }
+}
+
+/// Runs one design through [`crate::run`] with `options`. Never fails: a design out of range,
+/// one that cannot be form-found, or even a panic becomes an error row.
+pub fn run_one(v: &Variation, parameters: Vec<String>, options: &Options) -> DesignRun {
+    let failed = |reason: String| DesignRun {
+        record: error_record(v, parameters.clone(), reason),
+        summary: None,
+        report_html: None,
+    };
+    let design = match &v.design {
+        Ok(d) => d,
+        Err(reason) => return failed(reason.clone()),
+    };
+    let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| -> Result<DesignRun, String> {
+        let out = crate::run(design, options, &no_progress).map_err(|e| e.to_string())?;
+        let cap = &out.cap;
+        let robot = out
+            .robot
+            .as_ref()
+            .map(|r| r.as_ref().err().map(ToString::to_string));
+        let input = out.report_input();
+        let html = kappe_report::render_html(&input)
+            .map_err(|e| format!("cannot render the report: {e}"))?;
+        let summary = out.summary();
+        let fold = |f: fn(&crate::StateSummary) -> f64, init: f64, pick: fn(f64, f64) -> f64| {
+            cap.states.iter().map(f).fold(init, pick)
+        };
+        let record = Record {
+            index: v.index,
+            name: v.name.clone(),
+            parameters: parameters.clone(),
+            outcome: if out.ok { Verdict::Pass } else { Verdict::Fail },
+            error: None,
+            max_compression_stress_pa: Some(fold(
+                |s| s.forces.max_compression_stress,
+                0.0,
+                f64::min,
+            )),
+            max_tension_stress_pa: Some(fold(|s| s.forces.max_tension_stress, 0.0, f64::max)),
+            max_overhang_m: Some(cap.overhangs.iter().fold(0.0, |m, o| m.max(o.abs()))),
+            min_blf: out.min_blf(),
+            mass_kg: Some(cap.path.mass),
+            print_time_s: Some(cap.path.time),
+            states: Some(cap.states.len()),
+            robot: robot.map(|e| e.map_or_else(|| "ok".into(), |e| format!("failed: {e}"))),
+            constraints: input.constraints,
+            report: Some(format!("designs/{}/report.html", v.name)),
+        };
+        Ok(DesignRun {
+            record,
+            summary: Some(summary),
+            report_html: Some(html),
+        })
+    }));
+    match outcome {
+        Ok(Ok(run)) => run,
+        Ok(Err(e)) => failed(e),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            failed(format!("internal error (panic): {what}"))
+        }
+    }
+}
+
+/// The study result of `rows` (in study order) of `study`, run with the robot unless
+/// `no_robot`, as shard `shard` or whole.
+///
+/// # Errors
+/// None in practice: the result is round-tripped through JSON (see below), which cannot fail
+/// for these types; the error is kept rather than unwrapped.
+pub fn collect(
+    study: &Study,
+    shard: Option<(usize, usize)>,
+    no_robot: bool,
+    rows: Vec<Record>,
+) -> Result<StudyResult, StudyError> {
+    let r = StudyResult {
+        format: RESULT_FORMAT.into(),
+        version: 1,
+        title: study.title.clone(),
+        // Shards run with and without the robot must not be merged.
+        fingerprint: if no_robot {
+            format!("{}-no-robot", study.fingerprint)
+        } else {
+            study.fingerprint.clone()
+        },
+        designs: study.variations.iter().map(|v| v.name.clone()).collect(),
+        shard: shard.map(|(i, n)| [i, n]),
+        parameters: study.parameters.clone(),
+        rows,
+    };
+    // The files are rendered from the rows as `study.json` stores them, so that a merge of
+    // shards (which reads them back from JSON) writes exactly the same bytes.
+    let bytes = serde_json::to_vec(&r).map_err(|e| StudyError::Merge(e.to_string()))?;
+    serde_json::from_slice(&bytes).map_err(|e| StudyError::Merge(e.to_string()))
+}
