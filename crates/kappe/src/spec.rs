@@ -39,6 +39,10 @@ pub struct CapSpec {
     pub length: f64,
     /// am: tilt of every layer plane from the vertical, degrees.
     pub tilt_deg: f64,
+    /// What the first centre layer leans on: `"start_section"` (default, method.md §6) or
+    /// `"end_wall"` (an end wall takes the stack thrust; `kappe::ends`).
+    #[serde(skip_serializing_if = "crate::ends::EndKind::is_default")]
+    pub end: crate::ends::EndKind,
 }
 
 /// Material (method.md §2–3).
@@ -158,6 +162,7 @@ impl Default for CapSpec {
             rise: 0.2,
             length: 0.6,
             tilt_deg: 25.0,
+            end: crate::ends::EndKind::StartSection,
         }
     }
 }
