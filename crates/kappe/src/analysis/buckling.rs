@@ -64,25 +64,42 @@ pub struct StateBuckling {
     pub shell_nodes: usize,
 }
 
+/// Mode 1 of a state as the translations (ux, uy, uz, scaled to max |·| = 1 over all six
+/// freedoms, as `kappe_fe` returns it) of each shell node, keyed by its network node index: what
+/// the report draws. Empty when the state has no mode.
+pub type NetworkMode = Vec<(usize, [f64; 3])>;
+
 /// Buckling analysis of one state (shell model + `kappe_fe::buckling`).
 pub fn state_buckling(
     state: &State,
     material: &ShellMaterial,
     options: &AnalysisOptions,
 ) -> Result<StateBuckling, DesignError> {
+    state_buckling_mode(state, material, options).map(|(b, _)| b)
+}
+
+/// [`state_buckling`] and its first mode shape.
+pub fn state_buckling_mode(
+    state: &State,
+    material: &ShellMaterial,
+    options: &AnalysisOptions,
+) -> Result<(StateBuckling, NetworkMode), DesignError> {
     let shell = match state_shell(state, material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
-            return Ok(StateBuckling {
-                status: BucklingStatus::SingleLayer,
-                factors: Vec::new(),
-                location: None,
-                mechanism: None,
-                shell_nodes: 0,
-            });
+            return Ok((
+                StateBuckling {
+                    status: BucklingStatus::SingleLayer,
+                    factors: Vec::new(),
+                    location: None,
+                    mechanism: None,
+                    shell_nodes: 0,
+                },
+                Vec::new(),
+            ));
         }
     };
-    shell_buckling(&shell, state.index, options)
+    shell_buckling_mode(&shell, state.index, options)
 }
 
 /// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
@@ -92,6 +109,15 @@ pub fn shell_buckling(
     state: usize,
     options: &AnalysisOptions,
 ) -> Result<StateBuckling, DesignError> {
+    shell_buckling_mode(shell, state, options).map(|(b, _)| b)
+}
+
+/// [`shell_buckling`] and its first mode shape.
+pub fn shell_buckling_mode(
+    shell: &StateShell,
+    state: usize,
+    options: &AnalysisOptions,
+) -> Result<(StateBuckling, NetworkMode), DesignError> {
     let fe_opts = kappe_fe::BucklingOptions {
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
@@ -111,17 +137,30 @@ pub fn shell_buckling(
                     .max_by(|a, b| a.1.total_cmp(&b.1))?;
                 Some((*shell.node_layer.get(i)?, *shell.model.nodes.get(i)?))
             });
-            Ok(StateBuckling {
-                status: if r.factors.is_empty() {
-                    BucklingStatus::NoPositiveFactor
-                } else {
-                    BucklingStatus::Analysed
+            let mode = r
+                .modes
+                .first()
+                .map(|m| {
+                    m.iter()
+                        .zip(&shell.network_node)
+                        .map(|(d, &ni)| (ni, [d[0], d[1], d[2]]))
+                        .collect()
+                })
+                .unwrap_or_default();
+            Ok((
+                StateBuckling {
+                    status: if r.factors.is_empty() {
+                        BucklingStatus::NoPositiveFactor
+                    } else {
+                        BucklingStatus::Analysed
+                    },
+                    factors: r.factors,
+                    location,
+                    mechanism: None,
+                    shell_nodes: n,
                 },
-                factors: r.factors,
-                location,
-                mechanism: None,
-                shell_nodes: n,
-            })
+                mode,
+            ))
         }
         Err(kappe_fe::FeError::Mechanism { free_dofs }) => {
             let mut layers: Vec<i32> = free_dofs
@@ -137,16 +176,19 @@ pub fn shell_buckling(
             layers.sort_unstable();
             layers.dedup();
             let dofs: Vec<String> = free_dofs.iter().take(6).map(|d| d.to_string()).collect();
-            Ok(StateBuckling {
-                status: BucklingStatus::Mechanism,
-                factors: Vec::new(),
-                location: first,
-                mechanism: Some(format!(
-                    "the shell model is a mechanism in layer(s) {layers:?} (free DOFs: {})",
-                    dofs.join(", ")
-                )),
-                shell_nodes: n,
-            })
+            Ok((
+                StateBuckling {
+                    status: BucklingStatus::Mechanism,
+                    factors: Vec::new(),
+                    location: first,
+                    mechanism: Some(format!(
+                        "the shell model is a mechanism in layer(s) {layers:?} (free DOFs: {})",
+                        dofs.join(", ")
+                    )),
+                    shell_nodes: n,
+                },
+                Vec::new(),
+            ))
         }
         Err(e) => Err(DesignError::State {
             state,

@@ -7,7 +7,9 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::buckling::{BucklingStatus, StateBuckling, state_buckling, state_material};
+use super::buckling::{
+    BucklingStatus, NetworkMode, StateBuckling, state_buckling_mode, state_material,
+};
 use super::options::AnalysisOptions;
 use super::stress::{ElementStress, STRESS_REL_TOL, element_stresses};
 use crate::error::DesignError;
@@ -41,6 +43,10 @@ pub struct StateAnalysis {
     pub shell_nodes: usize,
     /// Seconds spent on the FE model of this state (build + solve).
     pub fe_seconds: f64,
+    /// Mode 1 per shell node (network node index, translation), for the report's 3D view;
+    /// empty when not analysed. Not in `summary.json`.
+    #[serde(skip)]
+    pub mode: super::buckling::NetworkMode,
 }
 
 /// One constraint of the report.
@@ -202,6 +208,7 @@ pub(crate) fn analyze_until(
         stresses: Vec<ElementStress>,
         stress_seconds: f64,
         buckling: Option<StateBuckling>,
+        mode: NetworkMode,
         fe_seconds: f64,
         top_layer: i32,
     }
@@ -218,6 +225,7 @@ pub(crate) fn analyze_until(
                 stresses,
                 stress_seconds: t0.elapsed().as_secs_f64(),
                 buckling: None,
+                mode: Vec::new(),
                 fe_seconds: 0.0,
                 top_layer: state.top_layer,
             })
@@ -230,22 +238,23 @@ pub(crate) fn analyze_until(
     let mut order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
     order.reverse();
     let n_fe = order.len();
-    let fe: Vec<(usize, StateBuckling, f64)> = order
+    let fe: Vec<(usize, StateBuckling, NetworkMode, f64)> = order
         .into_par_iter()
         .map(|top| {
             cancelled()?;
             let t0 = Instant::now();
             let state = build_state(&cap.sections, &cap.frame, phi, top)?;
             let mat = state_material(cap, options, top);
-            let b = state_buckling(&state, &mat, options)?;
+            let (b, mode) = state_buckling_mode(&state, &mat, options)?;
             on_state(n_fe);
-            Ok((top, b, t0.elapsed().as_secs_f64()))
+            Ok((top, b, mode, t0.elapsed().as_secs_f64()))
         })
         .collect::<Result<_, DesignError>>()?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
-    for (top, b, secs) in fe {
+    for (top, b, mode, secs) in fe {
         if let Some(p) = per.get_mut(top) {
             p.buckling = Some(b);
+            p.mode = mode;
             p.fe_seconds = secs;
         }
     }
@@ -333,6 +342,7 @@ pub(crate) fn analyze_until(
             mechanism,
             shell_nodes: nodes,
             fe_seconds: p.fe_seconds,
+            mode: p.mode.clone(),
         });
     }
 

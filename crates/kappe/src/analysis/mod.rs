@@ -36,7 +36,10 @@ pub mod overhang;
 pub mod stress;
 
 pub use ageing::Ageing;
-pub use buckling::{BucklingStatus, StateBuckling, shell_buckling, state_buckling, state_material};
+pub use buckling::{
+    BucklingStatus, NetworkMode, StateBuckling, shell_buckling, shell_buckling_mode,
+    state_buckling, state_buckling_mode, state_material,
+};
 pub use check::{Analysis, ConstraintResult, StateAnalysis, Timings, analyze};
 pub use options::{AnalysisOptions, SelectionError, StateSelection};
 pub use overhang::layer_overhangs;
