@@ -33,6 +33,11 @@ pub struct ScheduleSpec {
 pub const DEFAULT_RELOCATION_TIME: f64 = 60.0;
 
 impl ScheduleSpec {
+    /// Nothing set (the table is left out when a design is written back).
+    pub fn is_empty(&self) -> bool {
+        self == &ScheduleSpec::default()
+    }
+
     /// The wait after each of `layers` layers, checked: finite, ≥ 0, and a list that covers the
     /// print.
     pub fn waits(&self, layers: usize) -> Result<Vec<f64>, DesignError> {

@@ -23,6 +23,9 @@ pub struct Design {
     pub constraints: ConstraintSpec,
     /// Robot and tool settings (used by the motion planner).
     pub robot: RobotSpec,
+    /// The print schedule: waits after layers, station-change time (green-state.md §3).
+    #[serde(skip_serializing_if = "crate::schedule::ScheduleSpec::is_empty")]
+    pub schedule: crate::schedule::ScheduleSpec,
     /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
     pub analysis: crate::analysis::AnalysisOptions,
 }
@@ -55,6 +58,10 @@ pub struct MaterialSpec {
     pub youngs_modulus: f64,
     /// ν: Poisson's ratio.
     pub poisson_ratio: f64,
+    /// `[material.time]`: E and strength growing with the age of a layer (None: constant E
+    /// and the σ limits of `[constraints]`, as before).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<crate::material::TimeModelSpec>,
 }
 
 /// Bead and path (method.md §2, §7).
@@ -150,6 +157,7 @@ impl Default for Design {
             print: PrintSpec::default(),
             constraints: ConstraintSpec::default(),
             robot: RobotSpec::default(),
+            schedule: crate::schedule::ScheduleSpec::default(),
             analysis: crate::analysis::AnalysisOptions::default(),
         }
     }
@@ -173,6 +181,7 @@ impl Default for MaterialSpec {
             specific_weight: 23044.0,
             youngs_modulus: 10.0e6,
             poisson_ratio: 0.35,
+            time: None,
         }
     }
 }
@@ -226,6 +235,35 @@ impl Design {
     /// Layer tilt am in radians.
     pub fn tilt(&self) -> f64 {
         self.cap.tilt_deg.to_radians()
+    }
+
+    /// The green-state time model: `[material.time]`, or the older `[analysis.ageing]` (linear
+    /// E only) read as the same model; the constant model with `[material] youngs_modulus`
+    /// when neither is given. Both at once is an error.
+    pub fn time_model(&self) -> Result<crate::material::TimeModel, DesignError> {
+        use crate::material::{Property, TimeLaw, TimeModel};
+        match (&self.material.time, &self.analysis.ageing) {
+            (Some(_), Some(_)) => Err(DesignError::Invalid {
+                field: "analysis.ageing",
+                value: "given together with [material.time]".into(),
+                allowed: "allowed: one time model; [analysis.ageing] is the older form of \
+                          [material.time] (model = \"linear\", youngs_modulus, \
+                          youngs_modulus_rate, youngs_modulus_max): move it there"
+                    .into(),
+            }),
+            (Some(t), None) => t.resolve(self.material.youngs_modulus),
+            (None, Some(a)) => Ok(TimeModel {
+                law: TimeLaw::Linear,
+                time_constant: f64::INFINITY,
+                youngs_modulus: Property {
+                    initial: a.initial_modulus,
+                    rate: a.rate,
+                    max: a.max_modulus,
+                },
+                strength: None,
+            }),
+            (None, None) => Ok(TimeModel::constant(self.material.youngs_modulus)),
+        }
     }
 
     /// l_o,max, defaulting to lw/2 (method.md §3).
@@ -388,6 +426,9 @@ impl Design {
             )?;
         }
         self.analysis.validate()?;
+        self.time_model()?;
+        self.schedule.waits(self.schedule.waits.len().max(1))?;
+        self.schedule.relocation_time()?;
         let bm = &self.robot.beams;
         check(
             "robot.beams.width",
