@@ -6,7 +6,6 @@
 mod cmd;
 mod exit;
 mod output;
-mod report_input;
 
 use std::process::ExitCode;
 
@@ -32,8 +31,8 @@ enum Command {
     Robot(cmd::robot::RobotCommand),
     /// Design a cap ceiling: form-find every print state, analyse, write outputs.
     Design(cmd::design::DesignArgs),
-    /// Write a commented example design file.
-    Init(cmd::design::InitArgs),
+    /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability.
+    Init(cmd::init::InitArgs),
     /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
     Study(cmd::study::StudyCommand),
     /// Derive BLF_min (or the effective E) from printed prototypes that stood or failed.
@@ -56,7 +55,7 @@ fn main() -> ExitCode {
         Command::Fe(c) => cmd::fe::run(c),
         Command::Robot(c) => cmd::robot::run(c),
         Command::Design(a) => cmd::design::run(a),
-        Command::Init(a) => cmd::design::init(a),
+        Command::Init(a) => cmd::init::init(a),
         Command::Study(c) => cmd::study::run(c),
         Command::Calibrate(a) => cmd::calibrate::run(a),
         Command::Optimize(a) => cmd::optimize::run(a),

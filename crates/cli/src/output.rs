@@ -374,6 +374,7 @@ fn classify_existing(target: &Path, force: bool) -> Result<Previous> {
         Some(listed) => present
             .iter()
             .filter(|f| f.as_str() != MANIFEST && !listed.contains(*f))
+            .filter(|f| !in_nested_output(target, f))
             .cloned()
             .collect(),
         None => present.clone(),
@@ -403,6 +404,28 @@ fn classify_existing(target: &Path, force: bool) -> Result<Previous> {
         free_aside_name(target).display()
     ))
     .into())
+}
+
+/// Whether the relative file `rel` lies inside a nested Kappe output below `root` (e.g.
+/// `kappe robot resume` writes `resume_from_layer_K/` into a design's output) whose own manifest
+/// lists it.
+fn in_nested_output(root: &Path, rel: &str) -> bool {
+    let parts: Vec<&str> = rel.split('/').collect();
+    (1..parts.len()).any(|depth| {
+        let sub = root.join(parts[..depth].join("/"));
+        let inner = parts[depth..].join("/");
+        std::fs::read(sub.join(MANIFEST))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .and_then(|v| {
+                v.get("files")?
+                    .as_array()
+                    .map(|a| {
+                        inner == MANIFEST || a.iter().any(|f| f.as_str() == Some(inner.as_str()))
+                    })
+            })
+            .unwrap_or(false)
+    })
 }
 
 fn list_entries_empty(dir: &Path) -> bool {

@@ -31,7 +31,9 @@ pub mod shell;
 pub mod spec;
 pub mod states;
 pub mod study;
+pub mod templates;
 pub mod verdict;
+pub mod window;
 
 /// The analysis under its old name (`kappe::constraints`), for code written before the split;
 /// use [`analysis`].

@@ -5,6 +5,7 @@ pub mod calibrate;
 pub mod cem;
 pub mod design;
 pub mod fe;
+pub mod init;
 pub mod optimize;
 pub mod robot;
 pub mod study;

@@ -18,8 +18,8 @@
 //! ```
 //!
 //! Writes `design.toml` (the result) and `optimize.json` (every evaluation, the path taken, the
-//! verification) atomically into `--out`. Exit code 0 if the result satisfies every constraint,
-//! 2 if not (the binding constraints are named).
+//! verification) atomically into `--out`. Exit status 0 if the result satisfies every
+//! constraint, 1 if no design within the bounds does (the binding constraints are named).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -29,15 +29,19 @@ use clap::Args;
 use kappe::calibrate::DesignSource;
 use kappe::design_loop::{OptimizeFile, optimize};
 
-use crate::output::write_dir_atomic;
+use crate::exit::{self, Usage};
+use crate::output::prepare_dir;
 
 #[derive(Args)]
 pub struct OptimizeArgs {
     /// Design file with an [optimize] table, or an optimize file.
     pub file: PathBuf,
-    /// Output directory (replaced atomically).
+    /// Output directory (created, or replaced if it is a previous Kappe output).
     #[arg(long, short, default_value = "out-optimize")]
     pub out: PathBuf,
+    /// Also replace a non-empty directory that is not a Kappe output, by moving it aside.
+    #[arg(long)]
+    pub force: bool,
     /// Override the evaluation budget.
     #[arg(long)]
     pub max_evaluations: Option<usize>,
@@ -77,14 +81,15 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     let (mut file, embedded) = OptimizeFile::from_any_toml_str(&text)
         .with_context(|| format!("invalid optimize file {}", path.display()))?;
     if let Some(n) = args.max_evaluations {
-        anyhow::ensure!(
-            (1..=10_000).contains(&n),
-            "--max-evaluations {n}: allowed 1 to 10000"
-        );
+        if !(1..=10_000).contains(&n) {
+            return Err(Usage(format!("--max-evaluations {n}: allowed 1 to 10000")).into());
+        }
         file.max_evaluations = n;
     }
     let base = path.parent().unwrap_or(Path::new("."));
     let start = start_design(&file, embedded, base)?;
+    // Refusals and unwritable locations fail here, before the loop runs.
+    let prepared = prepare_dir(&args.out, args.force, "optimize")?;
     let quiet = args.quiet;
     if !quiet {
         println!(
@@ -120,11 +125,12 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         "result": &result,
     });
     let design_toml = result.design.to_toml_string();
-    write_dir_atomic(&args.out, |dir| {
-        std::fs::write(dir.join("design.toml"), &design_toml)?;
-        std::fs::write(dir.join("optimize.json"), serde_json::to_vec_pretty(&doc)?)?;
-        Ok(())
-    })?;
+    let dir = prepared.path();
+    std::fs::write(dir.join("design.toml"), &design_toml)?;
+    std::fs::write(dir.join("optimize.json"), serde_json::to_vec_pretty(&doc)?)?;
+    if let Some(notice) = prepared.commit()? {
+        eprintln!("note: {notice}");
+    }
 
     println!();
     println!("path taken (accepted moves):");
@@ -173,6 +179,6 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
             result.binding.join(", ")
         );
         println!("wrote {} (the least-violating design)", args.out.display());
-        Ok(ExitCode::from(2))
+        Ok(exit::fails())
     }
 }

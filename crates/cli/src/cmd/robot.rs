@@ -11,7 +11,7 @@ use kappe_robot::{
 };
 use serde::Deserialize;
 
-use crate::output::{write_dir_atomic, write_file_atomic};
+use crate::output::{prepare_dir, write_file_atomic};
 
 #[derive(Subcommand)]
 pub enum RobotCommand {
@@ -238,9 +238,12 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                     .with_context(|| format!("invalid config {}", c.display()))?,
                 None => Config::default(),
             };
+            // Refusals and unwritable locations fail before the planning.
+            let prepared = prepare_dir(&out, false, "robot plan")?;
             let plan = plan_print(&layers, &cfg.setup, &cfg.options)?;
             let files = linted_programs(&plan, "program_part")?;
-            write_dir_atomic(&out, |dir| write_plan_outputs(dir, &plan, &files))?;
+            write_plan_outputs(prepared.path(), &plan, &files)?;
+            prepared.commit()?;
             for s in &plan.slowdowns {
                 eprintln!(
                     "note: station {} layer {} point {} to layer {} point {}: tool slowed to {:.1} % of the design speed ({}), the flow with it",
@@ -320,7 +323,9 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
             }
             let files = linted_programs(&resumed, "resume_part")?;
             let out = out.unwrap_or_else(|| dir.join(format!("resume_from_layer_{from_layer}")));
-            write_dir_atomic(&out, |d| write_plan_outputs(d, &resumed, &files))?;
+            let prepared = prepare_dir(&out, false, "robot resume")?;
+            write_plan_outputs(prepared.path(), &resumed, &files)?;
+            prepared.commit()?;
             println!(
                 "resume from layer {from_layer}: {} waypoints, {} program(s), {:.1} s → {}",
                 resumed.waypoint_count(),
