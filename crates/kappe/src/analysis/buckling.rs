@@ -46,6 +46,7 @@ pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> Shell
         unit_weight: d.material.specific_weight,
         layer_modulus,
         youngs_modulus: d.material.youngs_modulus,
+        element: options.element,
     }
 }
 

@@ -4,6 +4,7 @@
 
 use std::str::FromStr;
 
+use kappe_fe::ElementKind;
 use serde::{Deserialize, Serialize};
 
 use super::ageing::Ageing;
@@ -134,6 +135,11 @@ fn default_stride() -> usize {
 fn default_true() -> bool {
     true
 }
+/// The shell element of the buckling analysis: the shear-deformable ANDES+DKMT (issue 17) —
+/// printed shells are thick (span/t ≈ 40) and the Kirchhoff DKT overestimates their BLF.
+fn default_element() -> ElementKind {
+    ElementKind::AndesDkmt
+}
 
 /// Options of [`analyze`](super::analyze); every field has a serde default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -157,6 +163,11 @@ pub struct AnalysisOptions {
     /// Prove with a Sturm count that no lower factor was missed (one extra factorization).
     #[serde(default)]
     pub sturm_check: bool,
+    /// Shell element (`kappe_fe::ElementKind` by name): `"andes_dkmt"` (default,
+    /// Reissner–Mindlin: transverse shear of the thick printed shell), `"cst_dkt"` (the
+    /// Kirchhoff element used before issue 17), `"andes_dkt"`, `"cst_dkmt"`.
+    #[serde(default = "default_element")]
+    pub element: ElementKind,
 }
 
 impl Default for AnalysisOptions {
@@ -168,6 +179,7 @@ impl Default for AnalysisOptions {
             row_stride: default_stride(),
             buckling: true,
             sturm_check: false,
+            element: default_element(),
         }
     }
 }
