@@ -57,10 +57,32 @@ pub fn robot_inputs(
     (setup, opts)
 }
 
-/// Plan the robot for the whole print.
+/// Plan the robot for the whole print: a continuous bead per station, timed on one clock (the
+/// design's minimum layer time gives the waits), cut into controller-sized programs, and
+/// verified with the capsules and with UR's collision meshes (`Plan::meshes`).
 pub fn plan_robot(cap: &Cap) -> Result<Plan, kappe_robot::RobotError> {
+    plan_robot_with_waits(cap, None)
+}
+
+/// [`plan_robot`] with per-layer waits (seconds after each layer, e.g. from the time-dependent
+/// schedule) instead of the minimum layer time. To change only the waits of a plan you already
+/// have, use [`kappe_robot::retime`].
+pub fn plan_robot_with_waits(
+    cap: &Cap,
+    waits: Option<&[kappe_robot::LayerWait]>,
+) -> Result<Plan, kappe_robot::RobotError> {
     let (setup, opts) = robot_inputs(cap);
-    kappe_robot::plan_print(&print_layers(&cap.path), &setup, &opts)
+    let mut plan =
+        kappe_robot::plan_print_with_waits(&print_layers(&cap.path), &setup, &opts, waits)?;
+    kappe_robot::meshes::attach_mesh_report(&mut plan, 1)?;
+    Ok(plan)
+}
+
+/// When each layer is printed on the plan's clock (start = arrival at its first target, end =
+/// arrival at its last, and the wait and whole pause after it): the times the programs and
+/// `trajectory.csv` use, for the structural schedule.
+pub fn layer_schedule(plan: &Plan) -> Vec<kappe_robot::LayerTime> {
+    kappe_robot::layer_times(plan)
 }
 
 /// The arm drawn as capsules over time, for the report's animation.

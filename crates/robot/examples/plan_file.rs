@@ -19,6 +19,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let plan = plan_print(&layers, &setup, &opts)?;
     let t_plan = t.elapsed().as_secs_f64();
     let t = Instant::now();
+    let rep = check_plan(&plan);
+    println!(
+        "check_plan alone: {:.3} s ({} problems)",
+        t.elapsed().as_secs_f64(),
+        rep.problems.len()
+    );
+    let t = Instant::now();
     let files = program_files(&plan, "program_part")?;
     let t_prog = t.elapsed().as_secs_f64();
     let t = Instant::now();

@@ -38,4 +38,4 @@ pub use setup::{
     BasePlacement, BaseSearch, PathPoint, PlanOptions, PlannerKind, PrintLayer, ProgramOptions,
     RobotSetup, Tool, ToolCapsule,
 };
-pub use timing::{LayerTime, LayerWait, Slowdown, apply_timing, layer_times};
+pub use timing::{LayerTime, LayerWait, Slowdown, apply_timing, layer_times, retime};

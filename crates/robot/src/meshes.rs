@@ -14,7 +14,7 @@ use parry3d_f64::math::Pose;
 use parry3d_f64::query;
 use parry3d_f64::shape::{Capsule, ConvexPolyhedron};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::collision::{LINK_NAMES, TOOL_LINK};
 use crate::error::RobotError;
@@ -179,7 +179,7 @@ impl ArmMeshes {
 }
 
 /// Where a model's smallest clearance or self distance occurs.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ClearanceAt {
     /// Metres (0 = touching or overlapping for the meshes; negative = overlap depth for capsules).
     pub distance: f64,
@@ -191,7 +191,7 @@ pub struct ClearanceAt {
 }
 
 /// Clearance of one geometric model over the checked waypoints.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ModelClearance {
     /// Smallest distance of the arm (links 1–6) to the environment (beams, mobile base, floor,
     /// printed layers), capped at [`MESH_CUTOFF`].
@@ -201,7 +201,7 @@ pub struct ModelClearance {
 }
 
 /// The plan measured with the capsules and with UR's collision meshes.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MeshReport {
     pub waypoints_checked: usize,
     pub mesh_vertices: Vec<usize>,
@@ -455,4 +455,15 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
         }
     }
     Ok(rep)
+}
+
+/// Run [`verify_meshes`] and keep the report in the plan (`Plan::meshes`); a mesh contact is an
+/// error, like any failed verification.
+pub fn attach_mesh_report(plan: &mut Plan, stride: usize) -> Result<(), RobotError> {
+    let rep = verify_meshes(plan, stride)?;
+    if !rep.problems.is_empty() {
+        return Err(RobotError::Verification(rep.problems));
+    }
+    plan.meshes = Some(rep);
+    Ok(())
 }

@@ -97,6 +97,10 @@ pub struct Plan {
     /// The program files, in order.
     #[serde(default)]
     pub parts: Vec<crate::program::ProgramPart>,
+    /// Clearances measured with UR's collision meshes and with the capsules, when checked
+    /// ([`crate::meshes::attach_mesh_report`]).
+    #[serde(default)]
+    pub meshes: Option<crate::meshes::MeshReport>,
     /// The setup (with the base placement resolved to the stations) and options used.
     pub setup: RobotSetup,
     pub options: PlanOptions,
@@ -941,6 +945,7 @@ fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
         max_acceleration_ratio: 0.0,
         slowdowns: Vec::new(),
         parts: Vec::new(),
+        meshes: None,
         setup,
         options: ctx.opts.clone(),
         stations,

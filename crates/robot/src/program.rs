@@ -496,6 +496,8 @@ pub fn resume_plan(plan: &Plan, layer: i64) -> Result<Plan, RobotError> {
         ));
     };
     let mut out = plan.clone();
+    // The mesh clearances were measured on the whole print.
+    out.meshes = None;
     out.stations.drain(..si);
     if let Some(st) = out.stations.first_mut() {
         st.layers.drain(..li);

@@ -90,6 +90,19 @@ pub fn layer_times(plan: &Plan) -> Vec<LayerTime> {
     out
 }
 
+/// The same plan re-timed with per-layer `waits` (e.g. from the time-dependent schedule, which
+/// needs [`layer_times`] first): the joint path and programs' cuts are kept, every time and
+/// speed follows the new pauses, and the result is re-checked.
+pub fn retime(plan: &Plan, waits: &[LayerWait]) -> Result<Plan, RobotError> {
+    let mut p = plan.clone();
+    apply_timing(&mut p, Some(waits))?;
+    let rep = crate::check::check_plan(&p);
+    if !rep.problems.is_empty() {
+        return Err(RobotError::Verification(rep.problems));
+    }
+    Ok(p)
+}
+
 /// Duration of a straight move of `dist` at cruise speed `v` with acceleration `a` from rest to
 /// rest (trapezoidal, or triangular when too short to reach `v`).
 pub fn trapezoid_time(dist: f64, v: f64, a: f64) -> f64 {
