@@ -1,0 +1,95 @@
+//! Issue 16: every input format has a page in `docs/formats/` holding the complete example that
+//! `kappe init --kind K` writes, verbatim, and that example runs as it is.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn kappe(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kappe"))
+        .current_dir(cwd)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn init(cwd: &Path, kind: &str) -> String {
+    let file = format!("{kind}.toml");
+    let o = kappe(cwd, &["init", "--kind", kind, &file]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(cwd.join(&file)).unwrap();
+    let doc = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../docs/formats/{kind}.md"));
+    let doc = std::fs::read_to_string(&doc).unwrap_or_else(|e| panic!("{}: {e}", doc.display()));
+    assert!(
+        doc.contains(&text),
+        "docs/formats/{kind}.md does not hold the example `kappe init --kind {kind}` writes"
+    );
+    file
+}
+
+/// Exit status 0 or 1 (the example ran; 1 = a design in it fails its checks) with `expect` in
+/// the output directory; 2 or 3 would mean the example is not a valid file.
+fn ran(o: &Output, out: &Path, expect: &str) {
+    let code = o.status.code().unwrap_or(-1);
+    assert!(
+        code == 0 || code == 1,
+        "status {code}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.join(expect).is_file(), "{expect} missing");
+}
+
+#[test]
+fn design_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "design");
+    // The buckling of every 8th state and no robot keep the debug-build test quick; the file
+    // is read as it is.
+    let o = kappe(
+        tmp.path(),
+        &["design", &file, "--out", "o", "--quiet", "--no-robot", "--states", "every:8"],
+    );
+    ran(&o, &tmp.path().join("o"), "summary.json");
+    assert_eq!(o.status.code(), Some(0), "the default design passes");
+}
+
+#[test]
+fn study_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "study");
+    let o = kappe(tmp.path(), &["study", &file, "--out", "s", "--quiet", "--no-robot"]);
+    ran(&o, &tmp.path().join("s"), "study.csv");
+    let csv = std::fs::read_to_string(tmp.path().join("s/study.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 4, "a 2 × 2 grid: header and four rows");
+}
+
+#[test]
+fn prototypes_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "prototypes");
+    let o = kappe(tmp.path(), &["calibrate", &file, "-o", "cal.json"]);
+    ran(&o, tmp.path(), "cal.json");
+}
+
+#[test]
+fn optimize_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "optimize");
+    let o = kappe(tmp.path(), &["optimize", &file, "--out", "o", "--quiet"]);
+    ran(&o, &tmp.path().join("o"), "design.toml");
+}
+
+#[test]
+fn buildability_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "buildability");
+    let o = kappe(tmp.path(), &["buildability", &file, "--out", "b"]);
+    ran(&o, &tmp.path().join("b"), "buildability.json");
+}
+
+#[test]
+fn unknown_kind_is_a_usage_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = kappe(tmp.path(), &["init", "--kind", "nonsense"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("study"));
+}
