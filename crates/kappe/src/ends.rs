@@ -152,3 +152,40 @@ pub fn stack_thrust(sections: &Sections, frame: &LayerFrame, top: usize) -> V3 {
 pub fn far_end_gap(rise: f64, tilt: f64) -> f64 {
     rise * tilt.tan()
 }
+
+/// The end-wall load of the final state of `cap` (`None` for a start-section cap), with the
+/// stack thrust it must equal.
+pub fn cap_wall_load(cap: &crate::pipeline::Cap) -> Option<CapWallLoad> {
+    let layer0 = cap
+        .sections
+        .print_index(0)
+        .and_then(|q| cap.sections.layers.get(q))?;
+    let load = wall_load(
+        &cap.final_state,
+        &cap.final_forces.reactions,
+        cap.areas(),
+        layer0.length(),
+    )?;
+    let thrust = stack_thrust(&cap.sections, &cap.frame, cap.sections.layers.len() - 1);
+    Some(CapWallLoad {
+        stack_thrust_n: [thrust.x, thrust.y, thrust.z],
+        max_column_force_n: load
+            .per_column
+            .iter()
+            .map(|c| V3::from(c.force).norm())
+            .fold(0.0, f64::max),
+        load,
+    })
+}
+
+/// The end-wall block of `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CapWallLoad {
+    /// The wall load of the final state (the largest: it grows with every layer).
+    #[serde(flatten)]
+    pub load: WallLoad,
+    /// Closed form Σ_i N·W_i·tan(am) toward −y, N: equals `total` (equilibrium check).
+    pub stack_thrust_n: [f64; 3],
+    /// Largest force of one column on the wall, N.
+    pub max_column_force_n: f64,
+}

@@ -93,7 +93,7 @@ pub fn summary_json(cap: &Cap) -> Value {
     let nc = cap.arch.segments() / 2;
     let crown = cap.arch.segment_forces.get(nc).copied().unwrap_or(0.0);
     let final_state = cap.states.last();
-    json!({
+    let mut out = json!({
         "format": "kappe.design.summary",
         "version": 1,
         "design": d,
@@ -146,7 +146,12 @@ pub fn summary_json(cap: &Cap) -> Value {
             "base_reaction_n": s.forces.base_reaction,
             "column_end_hv_ratio": s.forces.column_end_hv_ratio,
         })).collect::<Vec<_>>(),
-    })
+    });
+    // Only end-wall caps get the block, so the default summary stays byte-identical.
+    if let (Some(w), Some(obj)) = (crate::ends::cap_wall_load(cap), out.as_object_mut()) {
+        obj.insert("end_wall".into(), json!(w));
+    }
+    out
 }
 
 /// Merge an analysis into `summary.json`: per state `blf`, `max_compression_stress_pa`,

@@ -12,7 +12,7 @@ use crate::forces::{Sections2D, StateForces, state_forces};
 use crate::frame::LayerFrame;
 use crate::mesh::{TriMesh, bead_mesh};
 use crate::path::{PrintPath, print_path};
-use crate::section::{Sections, build_sections};
+use crate::section::{Sections, build_sections_with_end};
 use crate::spec::Design;
 use crate::states::{State, build_state};
 
@@ -110,13 +110,14 @@ pub(crate) fn design_cap_until(
     let catenary = Catenary::new(spec.span, spec.rise, tilt, spec.specific_weight);
     let bead_weight_per_m =
         design.material.specific_weight * design.print.layer_width * design.print.layer_height;
-    let sections = build_sections(
+    let sections = build_sections_with_end(
         &arch,
         &frame,
         design.cap.length,
         design.print.layer_height,
         design.print.start_arch_fraction,
         |chord| 0.5 * chord * bead_weight_per_m,
+        design.cap.end,
     )?;
     let overhangs = layer_overhangs(&sections, &frame);
     let phi = design.print.start_arch_fraction;

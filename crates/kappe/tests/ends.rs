@@ -167,3 +167,76 @@ fn start_section_is_the_default_end() {
     assert_eq!(a.n_start, 45, "method.md §6: K = 45 at the defaults");
     assert_eq!(a.end, EndKind::StartSection);
 }
+
+/// The 2.4 m bay of issue 15. With today's start section it fails σ_min at a start-section column
+/// foot. Against an end wall the start no longer crushes: the wall carries the thrust; the bay
+/// then fails σ_min for the reason the report names, the bed joint of layer 0 on the end wall,
+/// whose stress is the closed form N·W_i·tan(am) / (lw·l_trib) (method.md §5), and the wall
+/// load equals the stack thrust (1e-9 relative, see above).
+#[test]
+fn long_bay_against_an_end_wall() {
+    let stresses_only = kappe::Options {
+        analysis: Some(kappe::analysis::AnalysisOptions {
+            buckling: false,
+            ..Default::default()
+        }),
+        robot: false,
+        ..Default::default()
+    };
+    let mut d = Design::default();
+    d.cap.length = 2.4;
+    let start = kappe::run(&d, &stresses_only, &kappe::no_progress).unwrap();
+    let a = start.analysis.as_ref().unwrap();
+    let c = a
+        .constraints
+        .iter()
+        .find(|c| c.name == "sigma_min")
+        .unwrap();
+    assert!(!c.pass && c.element.contains("column foot"), "{c:?}");
+
+    d.cap.end = EndKind::EndWall;
+    let wall = kappe::run(&d, &stresses_only, &kappe::no_progress).unwrap();
+    assert!(!wall.ok);
+    let a = wall.analysis.as_ref().unwrap();
+    let c = a
+        .constraints
+        .iter()
+        .find(|c| c.name == "sigma_min")
+        .unwrap();
+    assert!(!c.pass);
+    assert!(
+        c.element.contains("end wall"),
+        "the report names the wall joint: {c:?}"
+    );
+    assert!(
+        a.constraints.iter().filter(|c| !c.pass).count() == 1,
+        "only σ_min fails"
+    );
+    let cap = &wall.cap;
+    let n = cap.sections.n_centre as f64;
+    let w_max = cap.sections.layers[0]
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.kind, NodeKind::Column(_)))
+        .map(|n| n.weight)
+        .fold(0.0, f64::max);
+    let sigma = -n * w_max * d.tilt().tan() / cap.areas().bed_joint;
+    // 1e-9 relative: the force pass sums N increments (see above).
+    assert!(
+        (c.worst.unwrap() - sigma).abs() <= 1e-9 * sigma.abs(),
+        "{:?} vs {sigma}",
+        c.worst
+    );
+    // ≈ γ·Cl·sin(am) (the interior tributary weight is γ·lw·lh·s): 23.4 kPa > 20 kPa.
+    assert!(
+        (sigma / -(d.material.specific_weight * d.cap.length * d.tilt().sin()) - 1.0).abs() < 0.01
+    );
+    // The wall load in summary.json equals the stack thrust.
+    let s = wall.summary();
+    let total: Vec<f64> = serde_json::from_value(s["end_wall"]["total"].clone()).unwrap();
+    let thrust: Vec<f64> = serde_json::from_value(s["end_wall"]["stack_thrust_n"].clone()).unwrap();
+    assert!((total[1] - thrust[1]).abs() <= 1e-9 * thrust[1].abs());
+    // The default design has no end-wall block (its summary is unchanged).
+    let plain = kappe::run(&Design::default(), &stresses_only, &kappe::no_progress).unwrap();
+    assert!(plain.summary().get("end_wall").is_none());
+}

@@ -39,6 +39,11 @@ pub enum ElementKind {
         /// Layer id.
         layer: i32,
     },
+    /// The bed joint of layer `layer` (0) on the end wall (`crate::ends`): A = lw·l_trib.
+    WallJoint {
+        /// Layer id.
+        layer: i32,
+    },
 }
 
 impl std::fmt::Display for ElementKind {
@@ -52,6 +57,9 @@ impl std::fmt::Display for ElementKind {
             }
             ElementKind::ColumnFoot { layer } => {
                 write!(f, "column foot below layer {layer} (on the base plane)")
+            }
+            ElementKind::WallJoint { layer } => {
+                write!(f, "bed joint of layer {layer} on the end wall")
             }
         }
     }
@@ -106,7 +114,10 @@ pub fn element_stresses(
         let (Some(nu), Some(nv)) = (net.nodes.get(u), net.nodes.get(v)) else {
             continue;
         };
-        let kind = if nv.role == Role::ColumnEnd {
+        // A column end above the base plane lies on an end-wall face (`crate::ends`).
+        let kind = if nv.role == Role::ColumnEnd && nv.xyz.z > 0.0 {
+            ElementKind::WallJoint { layer: nu.layer }
+        } else if nv.role == Role::ColumnEnd {
             ElementKind::ColumnFoot { layer: nu.layer }
         } else {
             ElementKind::BedJoint {
