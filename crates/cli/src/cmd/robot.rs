@@ -240,7 +240,8 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
             };
             // Refusals and unwritable locations fail before the planning.
             let prepared = prepare_dir(&out, false, "robot plan")?;
-            let plan = plan_print(&layers, &cfg.setup, &cfg.options)?;
+            let mut plan = plan_print(&layers, &cfg.setup, &cfg.options)?;
+            kappe_robot::meshes::attach_mesh_report(&mut plan, 1)?;
             let files = linted_programs(&plan, "program_part")?;
             write_plan_outputs(prepared.path(), &plan, &files)?;
             prepared.commit()?;
@@ -254,6 +255,16 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                     s.to.1,
                     100.0 * s.min_speed_ratio,
                     s.reason
+                );
+            }
+            if let Some(m) = &plan.meshes {
+                eprintln!(
+                    "clearance to the environment: arm capsules {:.4} m, arm meshes {:.4} m, nozzle {:.4} m; self: capsules {:.4} m, meshes {:.4} m",
+                    m.capsules.environment.distance,
+                    m.meshes.environment.distance,
+                    m.nozzle.distance,
+                    m.capsules.self_distance.distance,
+                    m.meshes.self_distance.distance
                 );
             }
             println!(
@@ -313,7 +324,8 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                     rep.problems.join("; ")
                 );
             }
-            let resumed = resume_plan(&plan, from_layer)?;
+            let mut resumed = resume_plan(&plan, from_layer)?;
+            kappe_robot::meshes::attach_mesh_report(&mut resumed, 1)?;
             let rep = check_plan(&resumed);
             if !rep.problems.is_empty() {
                 bail!(
