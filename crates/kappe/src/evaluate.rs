@@ -266,5 +266,10 @@ fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
         "min_clearance_m": plan.min_clearance,
         "min_self_distance_m": plan.min_self_distance,
         "max_speed_ratio": plan.max_speed_ratio,
+        "max_acceleration_ratio": plan.max_acceleration_ratio,
+        "programs": plan.parts.len(),
+        "slowdowns": plan.slowdowns,
+        "layer_times": kappe_robot::layer_times(plan),
+        "geometry": plan.meshes,
     })
 }
