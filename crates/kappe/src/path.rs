@@ -1,7 +1,8 @@
 //! The print path (method.md §7): the bead centre line of every layer, in print order, with the
 //! nozzle-tip target lh/2 above it along the layer normal and the tool axis along −n.
 //! The direction alternates from layer to layer so the bead never stops; the layer change is the
-//! short move to the next layer's nearer foot.
+//! short move to the next layer's nearer foot, and it is printed (the robot plan keeps the pump
+//! running through it within a station, issue 13).
 
 use crate::frame::{LayerFrame, V3};
 use crate::section::Sections;
@@ -28,7 +29,7 @@ pub struct PrintPath {
     pub points: Vec<PathPoint>,
     /// Length printed (bead centre line), m.
     pub print_length: f64,
-    /// Length of the layer-change moves, m.
+    /// Length of the layer-change moves (printed, but not in `print_length` or `volume`), m.
     pub travel_length: f64,
     /// Printed volume lw·lh·length, m³.
     pub volume: f64,
