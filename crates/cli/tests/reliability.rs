@@ -348,3 +348,18 @@ fn fe_buckle_of_an_unloaded_mesh_says_so() {
     assert_eq!(code(&o), 2, "{}", stderr(&o));
     assert!(stderr(&o).contains("no load"), "{}", stderr(&o));
 }
+
+#[test]
+fn optimize_on_a_design_file_without_its_table_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("d.toml"), "[cap]\nspan = 0.9\n").unwrap();
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args(["optimize", "d.toml", "--out", "o"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("[optimize]"), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("unknown field"), "{}", stderr(&o));
+    assert!(!tmp.path().join("o").exists());
+}

@@ -126,6 +126,20 @@ impl OptimizeFile {
                     message: e.to_string().trim().to_string(),
                 })?;
         let Some(opt) = table.remove("optimize") else {
+            // A design file (it has design tables but no `free`) without its [optimize] table:
+            // say that, rather than "unknown field `cap`" from the optimize-file schema.
+            let design_tables = ["cap", "material", "print", "constraints", "robot", "analysis"];
+            if !table.contains_key("free") && design_tables.iter().any(|k| table.contains_key(*k))
+            {
+                return Err(DesignError::Parse {
+                    path: "optimize".into(),
+                    message: "this is a design file without an [optimize] table: add \
+                              [optimize.free] with the parameters to vary (e.g. \
+                              \"cap.rise\" = { min = 0.15, max = 0.3 }), or give an optimize \
+                              file (`kappe init --kind optimize`)"
+                        .into(),
+                });
+            }
             return Ok((OptimizeFile::from_toml_str(text)?, None));
         };
         let toml::Value::Table(opt) = opt else {
@@ -146,7 +160,12 @@ impl OptimizeFile {
                 message: e.to_string(),
             })
         };
-        let design = Design::from_toml_str(&ser(&table)?)?;
+        // Only an [optimize] table: the starting design is the default one.
+        let design = if table.is_empty() {
+            Design::default()
+        } else {
+            Design::from_toml_str(&ser(&table)?)?
+        };
         let file = OptimizeFile::from_toml_str(&ser(&opt)?).map_err(|e| match e {
             DesignError::Parse { path, message } => DesignError::Parse {
                 path: if path.is_empty() {

@@ -39,7 +39,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use kappe::calibrate::{DesignSource, Outcome, PrototypeFile, Resolved, calibrate};
 
-use crate::output::write_file_atomic;
+use crate::output::{check_user_file, write_user_file};
 
 #[derive(Args)]
 pub struct CalibrateArgs {
@@ -51,6 +51,9 @@ pub struct CalibrateArgs {
     /// Print the calibration as JSON to stdout instead of the text report.
     #[arg(long)]
     pub json: bool,
+    /// Replace an existing output file.
+    #[arg(long)]
+    pub force: bool,
 }
 
 fn resolve(file: &PrototypeFile, base: &Path) -> Result<Vec<Resolved>> {
@@ -87,6 +90,10 @@ fn resolve(file: &PrototypeFile, base: &Path) -> Result<Vec<Resolved>> {
 
 pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
     let path = &args.prototypes;
+    // Refusals and unwritable locations fail before any analysis.
+    if let Some(out) = &args.out {
+        check_user_file(out, args.force)?;
+    }
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read the prototype file {}", path.display()))?;
     if text
@@ -107,7 +114,7 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
         "calibration": cal,
     });
     if let Some(out) = &args.out {
-        write_file_atomic(out, &serde_json::to_vec_pretty(&doc)?)?;
+        write_user_file(out, &serde_json::to_vec_pretty(&doc)?, args.force)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
@@ -164,9 +171,6 @@ fn run_prints(args: &CalibrateArgs, text: &str) -> Result<ExitCode> {
                 .with_context(|| format!("invalid buildability spec {}", p.display()))?
         }
     };
-    if let Some(out) = &args.out {
-        crate::output::check_user_file(out, false)?;
-    }
     let cal = calibrate_prints(&spec, &file.fit, &file.prints).context("calibration failed")?;
     let doc = serde_json::json!({
         "format": "kappe.calibration.prints",
@@ -175,7 +179,7 @@ fn run_prints(args: &CalibrateArgs, text: &str) -> Result<ExitCode> {
         "calibration": cal,
     });
     if let Some(out) = &args.out {
-        write_file_atomic(out, &serde_json::to_vec_pretty(&doc)?)?;
+        write_user_file(out, &serde_json::to_vec_pretty(&doc)?, args.force)?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&doc)?);
