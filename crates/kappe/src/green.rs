@@ -211,43 +211,10 @@ pub fn check_state(
         (BucklingOutcome::Skipped, None)
     };
 
-    let mut strength: Option<WorstElement> = None;
-    let mut sliding: Option<WorstElement> = None;
-    if let (true, Some(st)) = (want_stress, &static_result) {
-        for (i, (res, info)) in st.elements.iter().zip(elements).enumerate() {
-            let t = age(info.younger);
-            let Some(mc) = time.mohr_coulomb(t) else {
-                continue;
-            };
-            let [sx, sy, sxy] = res.membrane_stress();
-            if options.strength {
-                let (s1, s2) = principal(sx, sy, sxy);
-                let u = mc.utilisation(s1, s2);
-                if strength.is_none_or(|w| u > w.utilisation) {
-                    strength = Some(WorstElement {
-                        utilisation: u,
-                        element: i,
-                        layer: info.younger,
-                        age_s: t,
-                        stresses: [s1, s2],
-                    });
-                }
-            }
-            if options.sliding {
-                let (sn, tau) = bed_traction(&res.frame, [sx, sy, sxy], info.bed_normal);
-                let u = mc.sliding_utilisation(tau, sn);
-                if sliding.is_none_or(|w| u > w.utilisation) {
-                    sliding = Some(WorstElement {
-                        utilisation: u,
-                        element: i,
-                        layer: info.younger,
-                        age_s: t,
-                        stresses: [sn, tau],
-                    });
-                }
-            }
-        }
-    }
+    let (strength, sliding) = match (want_stress, &static_result) {
+        (true, Some(st)) => stress_checks(st, elements, ages, time, options),
+        _ => (None, None),
+    };
 
     let buckling_u = match &buckling {
         BucklingOutcome::Factor { blf } => Some(options.blf_min / blf),
@@ -273,6 +240,58 @@ pub fn check_state(
     })
 }
 
+/// The worst strength and the worst bed-joint sliding element of a state.
+pub type StressWorst = (Option<WorstElement>, Option<WorstElement>);
+
+/// The strength and bed-joint sliding checks of a solved state: the worst element of each
+/// (None when not asked for or without a strength model). `st` is the linear static solution of
+/// the state's shell model, `elements` its elements' layers, `ages[k]` the age of layer k.
+pub fn stress_checks(
+    st: &kappe_fe::StaticResult,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &GreenOptions,
+) -> StressWorst {
+    let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
+    let mut strength: Option<WorstElement> = None;
+    let mut sliding: Option<WorstElement> = None;
+    for (i, (res, info)) in st.elements.iter().zip(elements).enumerate() {
+        let t = age(info.younger);
+        let Some(mc) = time.mohr_coulomb(t) else {
+            continue;
+        };
+        let [sx, sy, sxy] = res.membrane_stress();
+        if options.strength {
+            let (s1, s2) = principal(sx, sy, sxy);
+            let u = mc.utilisation(s1, s2);
+            if strength.is_none_or(|w| u > w.utilisation) {
+                strength = Some(WorstElement {
+                    utilisation: u,
+                    element: i,
+                    layer: info.younger,
+                    age_s: t,
+                    stresses: [s1, s2],
+                });
+            }
+        }
+        if options.sliding {
+            let (sn, tau) = bed_traction(&res.frame, [sx, sy, sxy], info.bed_normal);
+            let u = mc.sliding_utilisation(tau, sn);
+            if sliding.is_none_or(|w| u > w.utilisation) {
+                sliding = Some(WorstElement {
+                    utilisation: u,
+                    element: i,
+                    layer: info.younger,
+                    age_s: t,
+                    stresses: [sn, tau],
+                });
+            }
+        }
+    }
+    (strength, sliding)
+}
+
 fn fe_error(e: FeError) -> DesignError {
     DesignError::FormFinding(format!("green-state shell analysis: {e}"))
 }
@@ -296,4 +315,105 @@ pub fn bed_traction(frame: &[[f64; 3]; 3], s: [f64; 3], n: [f64; 3]) -> (f64, f6
     let sn = dot(&traction, &n);
     let shear: [f64; 3] = std::array::from_fn(|k| traction[k] - sn * n[k]);
     (sn, dot(&shear, &shear).sqrt())
+}
+
+/// The green-state inputs of a cap's analysis: the time model, the schedule and the print
+/// index of every layer id.
+#[derive(Debug, Clone)]
+pub struct CapGreen {
+    /// The design's time model.
+    pub time: TimeModel,
+    /// The cap's schedule (path length / speed + waits).
+    pub schedule: crate::schedule::Schedule,
+    index_of: std::collections::HashMap<i32, usize>,
+    bed_normal: [f64; 3],
+}
+
+impl CapGreen {
+    /// From a designed cap (errors: an invalid time model or schedule).
+    pub fn new(cap: &crate::pipeline::Cap) -> Result<CapGreen, DesignError> {
+        let n = cap.frame.n;
+        Ok(CapGreen {
+            time: cap.design.time_model()?,
+            schedule: crate::schedule::cap_schedule(cap)?,
+            index_of: cap
+                .sections
+                .layers
+                .iter()
+                .enumerate()
+                .map(|(q, l)| (l.id, q))
+                .collect(),
+            bed_normal: [n.x, n.y, n.z],
+        })
+    }
+
+    /// E of every printed layer (by id) at the state with top print index `top`; empty for the
+    /// constant model (the shell then uses `[material] youngs_modulus` everywhere, exactly as
+    /// without a time model).
+    pub fn layer_moduli(
+        &self,
+        cap: &crate::pipeline::Cap,
+        top: usize,
+    ) -> std::collections::HashMap<i32, f64> {
+        if self.time.is_constant() {
+            return std::collections::HashMap::new();
+        }
+        let ages = self.schedule.ages(top + 1);
+        cap.sections
+            .layers
+            .iter()
+            .zip(ages)
+            .map(|(l, t)| (l.id, self.time.modulus(t)))
+            .collect()
+    }
+
+    /// Strength and bed-joint sliding of the state with top print index `top` (None: no
+    /// strength model, or a single layer without a shell). One linear static solve of the
+    /// state's shell with `material` (its E per layer already aged).
+    pub fn stress_checks(
+        &self,
+        state: &crate::states::State,
+        material: &crate::shell::ShellMaterial,
+        row_stride: usize,
+        top: usize,
+    ) -> Result<Option<StressWorst>, DesignError> {
+        if self.time.strength.is_none() {
+            return Ok(None);
+        }
+        let Ok(shell) = crate::shell::state_shell(state, material, row_stride) else {
+            return Ok(None);
+        };
+        let elements: Vec<ElementLayers> = shell
+            .element_layers
+            .iter()
+            .map(|(a, b)| {
+                let qa = self.index_of.get(a).copied().unwrap_or(0);
+                let qb = self.index_of.get(b).copied().unwrap_or(0);
+                ElementLayers {
+                    stiffness: (qa, qb),
+                    younger: qa.max(qb),
+                    bed_normal: self.bed_normal,
+                }
+            })
+            .collect();
+        let st = match kappe_fe::linear_static(&shell.model) {
+            Ok(st) => st,
+            // A mechanism is reported by the buckling check.
+            Err(FeError::Mechanism { .. }) => return Ok(None),
+            Err(e) => {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!("static analysis for the strength check failed: {e}"),
+                });
+            }
+        };
+        let ages = self.schedule.ages(top + 1);
+        Ok(Some(stress_checks(
+            &st,
+            &elements,
+            &ages,
+            &self.time,
+            &GreenOptions::default(),
+        )))
+    }
 }

@@ -126,6 +126,13 @@ pub struct Schedule {
     pub layers: Vec<LayerTime>,
     /// Where the print times came from.
     pub source: TimeSource,
+    /// Print duration of each layer, s (kept so ages are sums of durations, not differences of
+    /// clock times: bit-for-bit the sums the analysis used before the schedule existed).
+    #[serde(skip)]
+    durations: Vec<f64>,
+    /// Pause after each layer (wait + relocation + layer change), s.
+    #[serde(skip)]
+    gaps: Vec<f64>,
 }
 
 impl Schedule {
@@ -141,6 +148,7 @@ impl Schedule {
         let get = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.0);
         let mut t = 0.0;
         let mut layers = Vec::with_capacity(durations.len());
+        let mut gaps = Vec::with_capacity(durations.len());
         for (k, &d) in durations.iter().enumerate() {
             if !(d.is_finite() && d >= 0.0) {
                 return Err(DesignError::Invalid {
@@ -157,9 +165,16 @@ impl Schedule {
                 wait_s: w,
                 relocation_s: r,
             });
-            t += d + w + r + get(changes, k);
+            let gap = w + r + get(changes, k);
+            gaps.push(gap);
+            t += d + gap;
         }
-        Ok(Schedule { layers, source })
+        Ok(Schedule {
+            layers,
+            source,
+            durations: durations.to_vec(),
+            gaps,
+        })
     }
 
     /// Constant layer time for `n` layers.
@@ -167,16 +182,42 @@ impl Schedule {
         Schedule::new(&vec![layer_time; n], waits, &[], &[], TimeSource::LayerTime)
     }
 
-    /// Age of layers 0..n at the state "n layers complete", s (empty for n = 0).
+    /// Age of layers 0..n at the state "n layers complete", s (empty for n = 0): summed from
+    /// the top down, age[k] = Σ_{j=k+1}^{n−1} (gap[j−1] + duration[j]).
     pub fn ages(&self, n: usize) -> Vec<f64> {
-        let n = n.min(self.layers.len());
-        let Some(top) = n.checked_sub(1).and_then(|t| self.layers.get(t)) else {
-            return Vec::new();
-        };
-        self.layers[..n]
+        let n = n.min(self.durations.len());
+        let mut ages = vec![0.0; n];
+        let mut t = 0.0;
+        for k in (0..n).rev() {
+            if let Some(a) = ages.get_mut(k) {
+                *a = t;
+            }
+            let d = self.durations.get(k).copied().unwrap_or(0.0);
+            let gap = k
+                .checked_sub(1)
+                .and_then(|j| self.gaps.get(j))
+                .copied()
+                .unwrap_or(0.0);
+            // A zero gap is skipped rather than added, so a schedule without waits gives the
+            // bit-identical sums of the durations.
+            t += d;
+            if gap != 0.0 {
+                t += gap;
+            }
+        }
+        ages
+    }
+
+    /// Replace the chosen waits (one per layer; missing entries 0) and recompute the clock.
+    pub fn with_waits(&self, waits: &[f64]) -> Result<Schedule, DesignError> {
+        let relocations: Vec<f64> = self.layers.iter().map(|l| l.relocation_s).collect();
+        let changes: Vec<f64> = self
+            .layers
             .iter()
-            .map(|l| top.end_s - l.end_s)
-            .collect()
+            .zip(&self.gaps)
+            .map(|(l, g)| g - l.wait_s - l.relocation_s)
+            .collect();
+        Schedule::new(&self.durations, waits, &relocations, &changes, self.source)
     }
 
     /// End of the last layer, s.
@@ -200,4 +241,38 @@ impl Schedule {
         }
         s
     }
+}
+
+/// The schedule of a cap without a robot plan: layer k prints for its path length / print speed,
+/// then waits `[schedule]` waits. Station changes are not known before the robot is planned and
+/// are left out, which is conservative: every pause only adds to the ages of the layers below
+/// it, and the timed robot never prints faster than the design speed.
+pub fn cap_schedule(cap: &crate::pipeline::Cap) -> Result<Schedule, DesignError> {
+    let speed = cap.design.print.print_speed;
+    let durations: Vec<f64> = cap
+        .sections
+        .layers
+        .iter()
+        .map(|l| l.length() / speed)
+        .collect();
+    let waits = cap.design.schedule.waits(durations.len())?;
+    Schedule::new(&durations, &waits, &[], &[], TimeSource::PathLength)
+}
+
+/// The schedule of a timed robot plan (`kappe_robot::timing::layer_times`): each layer's start
+/// and end on the plan's clock, its scheduled wait, and the rest of the pause after it (program
+/// change, re-priming, station change) as relocation.
+pub fn from_robot(times: &[kappe_robot::timing::LayerTime]) -> Result<Schedule, DesignError> {
+    let durations: Vec<f64> = times.iter().map(|t| t.end - t.start).collect();
+    let waits: Vec<f64> = times.iter().map(|t| t.wait).collect();
+    let rest: Vec<f64> = times
+        .windows(2)
+        .map(|w| (w[1].start - w[0].end - w[0].wait).max(0.0))
+        .collect();
+    let mut s = Schedule::new(&durations, &waits, &rest, &[], TimeSource::RobotPlan)?;
+    for (l, t) in s.layers.iter_mut().zip(times) {
+        l.start_s = t.start;
+        l.end_s = t.end;
+    }
+    Ok(s)
 }

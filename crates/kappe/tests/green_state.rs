@@ -342,3 +342,95 @@ fn waits_age_the_layers_below() {
     assert_eq!(s.total_s(), 45.0);
     assert!(s.to_csv().starts_with("layer,start_s,end_s,wait_s"));
 }
+
+/// The analysis of a design as comparable data: every state's BLF and stresses, the constraint
+/// report (timings left out: wall clock).
+fn analysis_fingerprint(design_toml: &str) -> (Vec<(Option<f64>, f64, f64)>, String) {
+    let design = kappe::Design::from_toml_str(design_toml).expect("design");
+    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let mut options = design.analysis.clone();
+    options.states = "every:10".parse().expect("selection");
+    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let states = a
+        .states
+        .iter()
+        .map(|s| (s.blf, s.max_compression_stress_pa, s.max_tension_stress_pa))
+        .collect();
+    (states, serde_json::to_string(&a.constraints).expect("json"))
+}
+
+#[test]
+fn constant_time_model_is_bit_for_bit_the_analysis_without_one() {
+    // A short cap keeps the test quick; every:10 still analyses a dozen states.
+    let base = "[cap]\nlength = 0.2\n";
+    let plain = analysis_fingerprint(base);
+    let constant = analysis_fingerprint(&format!("{base}[material.time]\nmodel = \"constant\"\n"));
+    // Exact equality (f64 ==): the constant model must not touch a single bit.
+    assert_eq!(plain, constant);
+    // A linear E(t) does change the BLFs (older layers stiffer): the test can fail.
+    let ageing = analysis_fingerprint(&format!(
+        "{base}[material.time]\nmodel = \"linear\"\nyoungs_modulus_rate = 1.0e5\n"
+    ));
+    assert_ne!(plain.0, ageing.0);
+}
+
+#[test]
+fn old_ageing_table_is_the_linear_time_model() {
+    // [analysis.ageing] is read as [material.time] linear E (one model, not two): same BLFs.
+    let base = "[cap]\nlength = 0.2\n";
+    let old = analysis_fingerprint(&format!(
+        "{base}[analysis.ageing]\ninitial_modulus = 5.0e6\nrate = 2.0e4\n"
+    ));
+    let new = analysis_fingerprint(&format!(
+        "{base}[material.time]\nmodel = \"linear\"\nyoungs_modulus = 5.0e6\nyoungs_modulus_rate = 2.0e4\n"
+    ));
+    let blfs = |f: &(Vec<(Option<f64>, f64, f64)>, String)| -> Vec<f64> {
+        f.0.iter().filter_map(|s| s.0).collect()
+    };
+    // Same layer ages (path length / speed, summed the same way) and the same E(t): equal to
+    // the solver's tolerance (1e-8 relative Lanczos residual; 1e-7 leaves room for the
+    // different order in which the two paths fill the per-layer moduli).
+    for (a, b) in blfs(&old).iter().zip(blfs(&new)) {
+        assert!((a / b - 1.0).abs() < 1e-7, "{a} vs {b}");
+    }
+    // Both at once: an error pointing to the new table.
+    let e = kappe::Design::from_toml_str(&format!(
+        "{base}[analysis.ageing]\ninitial_modulus = 5.0e6\nrate = 2.0e4\n[material.time]\nmodel = \"linear\"\n"
+    ))
+    .expect_err("two time models");
+    assert!(e.to_string().contains("analysis.ageing") && e.to_string().contains("[material.time]"));
+}
+
+#[test]
+fn cap_reports_strength_and_sliding_with_ages() {
+    // The earth preset: today's constant E and f_c = 20 kPa (Tresca). The cap's analysis then
+    // reports the two green checks with the state, element, layer and age of the worst value.
+    let design = kappe::Design::from_toml_str(
+        "[cap]\nlength = 0.2\n[material.time]\npreset = \"earth\"\nyoungs_modulus = 10.0e6\n",
+    )
+    .expect("design");
+    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let mut options = design.analysis.clone();
+    options.states = "every:10".parse().expect("selection");
+    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let strength = a
+        .constraints
+        .iter()
+        .find(|c| c.name == "strength")
+        .expect("strength");
+    let sliding = a
+        .constraints
+        .iter()
+        .find(|c| c.name == "sliding")
+        .expect("sliding");
+    for c in [strength, sliding] {
+        let w = c.worst.expect("checked");
+        assert!(
+            w.is_finite() && w >= 0.0 && c.element.contains("age"),
+            "{c:?}"
+        );
+    }
+    // Sliding in the centre section: the leaning layer gives τ/σ_n ≈ tan(am) on the bed plane
+    // (method.md §5), so the sliding utilisation is not zero.
+    assert!(sliding.worst.unwrap_or(0.0) > 0.0);
+}

@@ -34,7 +34,11 @@ pub enum BucklingStatus {
 pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> ShellMaterial {
     let d = &cap.design;
     let layer_modulus = match &options.ageing {
-        None => HashMap::new(),
+        // `[material.time]` (issue 11): E per layer from its age on the cap's schedule; empty
+        // for the constant model, so the shell is exactly the one without a time model.
+        None => crate::green::CapGreen::new(cap)
+            .map(|g| g.layer_moduli(cap, top))
+            .unwrap_or_else(|_| HashMap::new()),
         Some(a) => layer_ages(&cap.sections, d.print.print_speed, top)
             .into_iter()
             .map(|(id, t)| (id, a.modulus(t)))

@@ -43,6 +43,16 @@ pub struct StateAnalysis {
     pub shell_nodes: usize,
     /// Seconds spent on the FE model of this state (build + solve).
     pub fe_seconds: f64,
+    /// Worst Mohr–Coulomb utilisation of the shell's membrane stresses (only with a strength
+    /// model in `[material.time]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strength_utilisation: Option<f64>,
+    /// Worst bed-joint sliding utilisation (only with a strength model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sliding_utilisation: Option<f64>,
+    /// Age of the oldest printed layer at this state, s (only with a time model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bottom_age_s: Option<f64>,
     /// Mode 1 per shell node (network node index, translation), for the report's 3D view;
     /// empty when not analysed. Not in `summary.json`.
     #[serde(skip)]
@@ -211,7 +221,16 @@ pub(crate) fn analyze_until(
         mode: NetworkMode,
         fe_seconds: f64,
         top_layer: i32,
+        green: Option<GreenChecks>,
     }
+    type GreenChecks = (
+        Option<crate::green::WorstElement>,
+        Option<crate::green::WorstElement>,
+    );
+    // Green state (issue 11): strength and bed-joint sliding with the layers' ages, only when
+    // `[material.time]` gives a strength model (otherwise nothing changes).
+    let green = crate::green::CapGreen::new(cap)?;
+    let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
     // Phase 1: every state's force pass and element stresses (cheap).
     let t_phase = Instant::now();
     let mut per: Vec<PerState> = (0..total)
@@ -228,6 +247,7 @@ pub(crate) fn analyze_until(
                 mode: Vec::new(),
                 fe_seconds: 0.0,
                 top_layer: state.top_layer,
+                green: None,
             })
         })
         .collect::<Result<_, DesignError>>()?;
@@ -238,7 +258,8 @@ pub(crate) fn analyze_until(
     let mut order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
     order.reverse();
     let n_fe = order.len();
-    let fe: Vec<(usize, StateBuckling, NetworkMode, f64)> = order
+    #[allow(clippy::type_complexity)]
+    let fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> = order
         .into_par_iter()
         .map(|top| {
             cancelled()?;
@@ -246,14 +267,19 @@ pub(crate) fn analyze_until(
             let state = build_state(&cap.sections, &cap.frame, phi, top)?;
             let mat = state_material(cap, options, top);
             let (b, mode) = state_buckling_mode(&state, &mat, options)?;
+            let g = match &green {
+                Some(g) => g.stress_checks(&state, &mat, options.row_stride, top)?,
+                None => None,
+            };
             on_state(n_fe);
-            Ok((top, b, mode, t0.elapsed().as_secs_f64()))
+            Ok((top, b, mode, g, t0.elapsed().as_secs_f64()))
         })
         .collect::<Result<_, DesignError>>()?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
-    for (top, b, mode, secs) in fe {
+    for (top, b, mode, g, secs) in fe {
         if let Some(p) = per.get_mut(top) {
             p.buckling = Some(b);
+            p.green = g;
             p.mode = mode;
             p.fe_seconds = secs;
         }
@@ -277,6 +303,10 @@ pub(crate) fn analyze_until(
     let mut w_tens: Option<Worst> = None;
     let mut w_blf: Option<Worst> = None;
     let mut w_lo: Option<Worst> = None;
+    let mut w_strength: Option<Worst> = None;
+    let mut w_sliding: Option<Worst> = None;
+    let mut green_checked = 0;
+    let layer_name = |k: usize| cap.sections.layers.get(k).map_or(0, |l| l.id);
     let mut blf_checked = 0;
     let mut states = Vec::with_capacity(total);
     let mut running_lo: f64 = 0.0;
@@ -329,7 +359,36 @@ pub(crate) fn analyze_until(
                 _ => {}
             }
         }
+        let (mut strength_u, mut sliding_u) = (None, None);
+        if let Some((st, sl)) = &p.green {
+            green_checked += 1;
+            for (w, slot, out) in [
+                (st, &mut w_strength, &mut strength_u),
+                (sl, &mut w_sliding, &mut sliding_u),
+            ] {
+                if let Some(w) = w {
+                    *out = Some(w.utilisation);
+                    ok &= w.utilisation <= 1.0;
+                    keep_max(slot, w.utilisation, q, || {
+                        format!(
+                            "shell element {} in layer {} (age {:.1} s; σ = {:.1}, {:.1} Pa)",
+                            w.element,
+                            layer_name(w.layer),
+                            w.age_s,
+                            w.stresses[0],
+                            w.stresses[1]
+                        )
+                    });
+                }
+            }
+        }
+        let bottom_age_s = green
+            .as_ref()
+            .and_then(|g| g.schedule.ages(q + 1).first().copied());
         states.push(StateAnalysis {
+            strength_utilisation: strength_u,
+            sliding_utilisation: sliding_u,
+            bottom_age_s,
             index: q,
             top_layer: p.top_layer,
             blf,
@@ -366,7 +425,7 @@ pub(crate) fn analyze_until(
             states_checked: checked,
         }
     };
-    let constraints = vec![
+    let mut constraints = vec![
         result(
             "sigma_min",
             "compressive stress: σ ≥ σ_min in every element",
@@ -404,6 +463,26 @@ pub(crate) fn analyze_until(
             &|v| v <= lo_max,
         ),
     ];
+    if green.as_ref().is_some_and(|g| g.time.strength.is_some()) {
+        constraints.push(result(
+            "strength",
+            "green strength: Mohr–Coulomb utilisation ≤ 1 on the shell's membrane stresses, c(t), φ(t) at the younger layer's age",
+            "1",
+            1.0,
+            w_strength,
+            green_checked,
+            &|v| v <= 1.0,
+        ));
+        constraints.push(result(
+            "sliding",
+            "bed-joint sliding: |τ| ≤ c(t) + σ_n·tan φ(t) on the bed plane, younger layer's age",
+            "1",
+            1.0,
+            w_sliding,
+            green_checked,
+            &|v| v <= 1.0,
+        ));
+    }
     let ok = constraints.iter().all(|c| c.pass);
     Ok(Analysis {
         states,
