@@ -58,32 +58,44 @@ pub fn fits_one_program(plan: &Plan) -> bool {
 /// ratio): one row per print waypoint at its arrival (`layer,index` as in `path.csv`), and a
 /// second row at its departure where the robot holds (priming, waits, program changes).
 /// `v_tool` is the planned tool speed of the move into the row (0 on a hold) and `flow` the
-/// pump set-point during it. Numbers use Rust's shortest round-trip formatting, so the file
+/// pump set-point during it (0 on the approach to a station, the first move's flow while
+/// priming, the hold output or 0 during pauses). Numbers use Rust's shortest round-trip formatting, so the file
 /// reads back to the same f64 values.
 pub fn write_trajectory_csv(plan: &Plan, mut w: impl Write) -> Result<(), RobotError> {
     verified(plan)?;
     writeln!(w, "station,layer,index,t,q1,q2,q3,q4,q5,q6,v_tool,flow")?;
-    let hold = plan.options.pump.hold();
+    let pump = &plan.options.pump;
+    // Set-point while holding at a layer's end: primed, or stopped.
+    let pause = match pump.pause {
+        crate::setup::PauseMode::KeepPrimed => pump.hold(),
+        crate::setup::PauseMode::Stop => 0.0,
+    };
     for (si, st) in plan.stations.iter().enumerate() {
-        for l in &st.layers {
-            for p in &l.waypoints {
-                let f = if p.speed > 0.0 {
-                    crate::program::flow_output(plan, p.speed)
-                } else {
-                    hold
-                };
-                write!(w, "{si},{},{},{}", l.layer, p.index, p.t)?;
+        let all: Vec<(i64, &crate::plan::Waypoint)> = st
+            .layers
+            .iter()
+            .flat_map(|l| l.waypoints.iter().map(move |w| (l.layer, w)))
+            .collect();
+        for (k, &(layer, p)) in all.iter().enumerate() {
+            // The flow during the move into this row: off on the approach to the station's
+            // first target; during its hold (priming) the first move's flow.
+            let (f_arrive, f_hold) = if k == 0 {
+                let v1 = all.get(1).map_or(plan.options.print_speed, |w| w.1.speed);
+                (0.0, crate::program::flow_output(plan, v1))
+            } else {
+                (crate::program::flow_output(plan, p.speed), pause)
+            };
+            write!(w, "{si},{layer},{},{}", p.index, p.t)?;
+            for q in p.q {
+                write!(w, ",{q}")?;
+            }
+            writeln!(w, ",{},{f_arrive}", p.speed)?;
+            if p.hold > 0.0 {
+                write!(w, "{si},{layer},{},{}", p.index, p.t + p.hold)?;
                 for q in p.q {
                     write!(w, ",{q}")?;
                 }
-                writeln!(w, ",{},{f}", p.speed)?;
-                if p.hold > 0.0 {
-                    write!(w, "{si},{},{},{}", l.layer, p.index, p.t + p.hold)?;
-                    for q in p.q {
-                        write!(w, ",{q}")?;
-                    }
-                    writeln!(w, ",0,{hold}")?;
-                }
+                writeln!(w, ",0,{f_hold}")?;
             }
         }
     }

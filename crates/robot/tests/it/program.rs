@@ -208,6 +208,11 @@ fn trajectory_rows_respect_limits_and_stay_on_the_path() {
     let (checked, _) = check_rows(&plan, &layers, &opts, 5.0);
     assert!(checked > 0);
     let rows = rows(&plan);
+    // The pump is off on the approach and primes at the first move's flow (0.02 × 0.008 m at
+    // 0.05 m/s = 0.48 L/min → 0.48 with the default factor 1 per L/min); 1e-12: round-off.
+    assert_eq!(rows[0].flow, 0.0);
+    assert!((rows[1].t - rows[0].t - opts.pump.prime_dwell).abs() < 1e-12);
+    assert!((rows[1].flow - 0.48).abs() < 1e-12, "{}", rows[1].flow);
     // Every layer change is a printed move: the rows go straight from a layer's last point to
     // the next layer's first (no row off the path in between, checked above by the FK).
     assert_eq!(
