@@ -37,6 +37,8 @@ enum Command {
     Study(cmd::study::StudyCommand),
     /// Derive BLF_min (or the effective E) from printed prototypes that stood or failed.
     Calibrate(cmd::calibrate::CalibrateArgs),
+    /// The least print time (waits per layer) for which every state passes the green-state checks.
+    Schedule(cmd::schedule::ScheduleArgs),
     /// Buildability of a test object (wall or cylinder): check every layer count with the green-state time model.
     Buildability(cmd::buildability::BuildabilityArgs),
     /// The design loop: vary the free parameters within bounds to meet every constraint with the least material.
@@ -60,6 +62,7 @@ fn main() -> ExitCode {
         Command::Calibrate(a) => cmd::calibrate::run(a),
         Command::Optimize(a) => cmd::optimize::run(a),
         Command::Buildability(a) => cmd::buildability::run(a),
+        Command::Schedule(a) => cmd::schedule::run(a),
     };
     match result {
         Ok(code) => code,

@@ -33,6 +33,7 @@ pub mod states;
 pub mod study;
 pub mod templates;
 pub mod verdict;
+pub mod wait_search;
 pub mod window;
 
 /// The analysis under its old name (`kappe::constraints`), for code written before the split;

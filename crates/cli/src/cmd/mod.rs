@@ -8,4 +8,5 @@ pub mod fe;
 pub mod init;
 pub mod optimize;
 pub mod robot;
+pub mod schedule;
 pub mod study;
