@@ -33,7 +33,7 @@ function canvasStats() {
   ctx.drawImage(src, 0, 0);
   const px = ctx.getImageData(0, 0, c.width, c.height).data;
   let n = 0, sum = 0, sum2 = 0, nonWhite = 0;
-  const B = 16;
+  const B = 32;
   const blocks = new Float64Array(B * B);
   const counts = new Float64Array(B * B);
   for (let i = 0; i < px.length; i += 4) {
@@ -53,8 +53,10 @@ function canvasStats() {
     blocks: Array.from(blocks, (s, k) => s / Math.max(1, counts[k])),
   };
 }
-// Mean absolute difference of two fingerprints, in luminance units (0–255).
+// Mean absolute difference of two fingerprints, in luminance units (0–255), and the largest
+// block difference (a local change such as a mode shape shows there).
 const diff = (a, b) => a.blocks.reduce((s, v, k) => s + Math.abs(v - b.blocks[k]), 0) / a.blocks.length;
+const maxDiff = (a, b) => a.blocks.reduce((m, v, k) => Math.max(m, Math.abs(v - b.blocks[k])), 0);
 
 // Distance from point p to the polyline through flat [x, y, z, …].
 function polylineDistance(p, flat) {
@@ -179,10 +181,13 @@ test('report.html: one timeline, robot and print together, orientation, mode sha
     await page.check('#show-mode');
     assert.notEqual(await page.evaluate(() => window.kappeReport.modeShown()), null, 'no mode shown at the end');
     const withMode = await page.evaluate(canvasStats);
-    assert.ok(diff(before, withMode) > 0.3, `mode-shape toggle did not change the picture (${diff(before, withMode)})`);
+    // A 32 × 32 block of the canvas changes by more than 10 grey levels (of 255): the displaced
+    // beads move into blocks that showed background or other beads. Noise between two renders
+    // of the same scene is 0 (the test checks it when the toggle goes off again).
+    assert.ok(maxDiff(before, withMode) > 10, `mode-shape toggle did not change the picture (${maxDiff(before, withMode)})`);
     await page.uncheck('#show-mode');
     const after = await page.evaluate(canvasStats);
-    assert.ok(diff(before, after) < diff(before, withMode), 'mode shape did not go away');
+    assert.ok(maxDiff(before, after) < 1, `mode shape did not go away (${maxDiff(before, after)})`);
   }
   // A constraint row with a worst place goes to that state and highlights the row.
   if (info.places.length > 0) {

@@ -17,11 +17,28 @@
 //! - `constraints`: [`preliminary_constraints`] (σ_min, σ_max, overhang, worst over all states),
 //!   then the analysis rows of [`ReportExtras::constraints`], which replace rows of the same
 //!   name and add new ones (BLF, robot reach, …).
+//! - `robot`, `timeline`, `cell` (issue 14): every waypoint of the robot plan (a second frame
+//!   at the end of a hold) with its station; the arrival time of the waypoint of each path point
+//!   (`layer, index`) is that point's time on the one timeline (without a plan: arc length over
+//!   the print speed); the cell is the plan's stations, tool, mobile base, box obstacles (the
+//!   beams) and floor.
+//! - `modes`: mode 1 of every analysed state (`StateAnalysis::mode`, per shell node) moved onto
+//!   the bead nodes: each shell node's network node goes to the nearest bead node of its layer.
+//! - `worst_places`: σ_min/σ_max at the midpoint of the extreme element of the worst state (one
+//!   force pass of that state), BLF at the peak of that state's mode 1, the overhang at the
+//!   crown of its layer (with the signed l_o).
+//! - `quantities`: with layer ageing in the analysis, each printed layer's age and modulus per
+//!   state, as the buckling analysis used them ([`crate::analysis::ageing`]).
+
+use std::collections::HashMap;
 
 use kappe_report::{
-    BedJoint, Bound, ConstraintRow, Layer, Parameter, Plot, PrintPath, PrintState, ReportInput,
-    RobotAnimation,
+    BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, Plot,
+    PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Station, Timeline,
+    WorstPlace,
 };
+
+use crate::analysis::{Ageing, NetworkMode};
 
 use crate::pipeline::Cap;
 use crate::verdict::{
@@ -62,6 +79,16 @@ pub struct ReportExtras {
     pub robot_error: Option<String>,
     /// Extra plots after the standard ones.
     pub plots: Vec<Plot>,
+    /// Arrival time of every waypoint of the plan, by (layer id, point index), s.
+    pub waypoint_times: Vec<(i64, usize, f64)>,
+    /// End of the robot plan, s.
+    pub plan_end: Option<f64>,
+    /// The robot cell of the plan.
+    pub cell: Option<Cell>,
+    /// Mode 1 of each analysed state: state position, its BLF, translations per network node.
+    pub modes: Vec<(usize, f64, NetworkMode)>,
+    /// The layer ageing the analysis used, if any.
+    pub ageing: Option<Ageing>,
 }
 
 /// The analysis of `crate::analysis::analyze` as report extras: per-state BLF and verdict,
@@ -104,20 +131,25 @@ pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtra
             })
         })
         .collect();
+    let modes = analysis
+        .states
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| Some((i, s.blf?, s.mode.clone())))
+        .filter(|(_, _, m)| !m.is_empty())
+        .collect();
     ReportExtras {
         states,
         constraints,
         ok: Some(analysis.ok),
+        modes,
+        ageing: analysis.options.ageing,
         ..ReportExtras::default()
     }
 }
 
-/// Frames of the robot animation embedded in the report, spread evenly over the plan: every
-/// waypoint would make the page large (~1 kB per frame for the 13 capsules of arm and tool).
-pub const ROBOT_FRAMES: usize = 600;
-
 /// The arm posed along the robot plan (`crate::robot_plan::arm_frames`) as the report's
-/// animation.
+/// animation (capsules; the report draws the UR10e meshes from [`plan_animation`] instead).
 pub fn robot_animation(frames: &crate::robot_plan::ArmFrames) -> RobotAnimation {
     RobotAnimation {
         times: frames.times.clone(),
@@ -128,8 +160,91 @@ pub fn robot_animation(frames: &crate::robot_plan::ArmFrames) -> RobotAnimation 
     }
 }
 
+/// Every waypoint of `plan` as the report's animation (joints and station per frame; a second
+/// frame at the end of a hold, so the arm waits where the plan waits), and the arrival time of
+/// each waypoint by (layer id, point index). About 32 bytes per frame in the page.
+pub fn plan_animation(plan: &kappe_robot::Plan) -> (RobotAnimation, Vec<(i64, usize, f64)>) {
+    let mut anim = RobotAnimation::default();
+    let mut times = Vec::new();
+    for (s, st) in plan.stations.iter().enumerate() {
+        for l in &st.layers {
+            for w in &l.waypoints {
+                anim.times.push(w.t);
+                anim.joints.push(w.q);
+                anim.station.push(s);
+                times.push((l.layer, w.index, w.t));
+                if w.hold > 0.0 {
+                    anim.times.push(w.t + w.hold);
+                    anim.joints.push(w.q);
+                    anim.station.push(s);
+                }
+            }
+        }
+    }
+    (anim, times)
+}
+
+/// The robot cell of `plan`: stations, tool, mobile base, box obstacles (the beams) and floor.
+pub fn plan_cell(plan: &kappe_robot::Plan) -> Cell {
+    let setup = &plan.setup;
+    Cell {
+        stations: plan
+            .stations
+            .iter()
+            .map(|s| Station {
+                world_from_base: s.world_from_base,
+                layers: s
+                    .layers
+                    .iter()
+                    .filter_map(|l| i32::try_from(l.layer).ok())
+                    .collect(),
+            })
+            .collect(),
+        flange_from_tcp: plan.flange_from_tcp,
+        tool: setup
+            .tool
+            .capsules
+            .iter()
+            .map(|c| Capsule {
+                a: c.a,
+                b: c.b,
+                radius: c.radius,
+            })
+            .collect(),
+        mobile_base: setup
+            .mobile_base
+            .iter()
+            .map(|b| BoxBody {
+                name: b.name.clone(),
+                center: b.center,
+                half_extents: b.half_extents,
+                yaw: 0.0,
+            })
+            .collect(),
+        obstacles: setup
+            .obstacles
+            .iter()
+            .filter_map(|o| match o {
+                kappe_robot::collision::Obstacle::Box {
+                    name,
+                    center,
+                    half_extents,
+                    yaw,
+                } => Some(BoxBody {
+                    name: name.clone(),
+                    center: *center,
+                    half_extents: *half_extents,
+                    yaw: *yaw,
+                }),
+                _ => None,
+            })
+            .collect(),
+        floor_z: setup.floor_z,
+    }
+}
+
 /// Adds the outcome of robot planning (`crate::robot_plan::plan_robot`): for a plan, the
-/// animation ([`ROBOT_FRAMES`] frames) and a passing `robot_plan` row whose element tells the
+/// animation ([`plan_animation`]), the timeline and the cell ([`plan_cell`]) and a passing `robot_plan` row whose element tells the
 /// stations and the minimum clearance; for a failure, [`ReportExtras::robot_error`] and a
 /// failing row whose element is the planner's reason.
 pub fn add_robot(
@@ -138,11 +253,11 @@ pub fn add_robot(
 ) {
     let (pass, element) = match plan {
         Ok(p) => {
-            // A plan that cannot be posed for the animation is still a valid plan: the page then
-            // shows no robot, and the verdict does not change.
-            extras.robot = crate::robot_plan::arm_frames(p, &p.setup.tool, ROBOT_FRAMES)
-                .ok()
-                .map(|f| robot_animation(&f));
+            let (anim, times) = plan_animation(p);
+            extras.robot = (!anim.times.is_empty()).then_some(anim);
+            extras.waypoint_times = times;
+            extras.plan_end = Some(p.total_time);
+            extras.cell = Some(plan_cell(p));
             (
                 true,
                 format!(
@@ -370,7 +485,7 @@ pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
         })
         .collect();
 
-    ReportInput {
+    let mut input = ReportInput {
         name: d.name.clone(),
         parameters: parameters(cap),
         layers,
@@ -380,7 +495,235 @@ pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
         constraints: constraint_rows(cap, extras),
         robot: extras.robot.clone(),
         plots: extras.plots.clone(),
-        ..ReportInput::default()
+        timeline: Some(timeline(cap, extras)),
+        cell: extras.cell.clone(),
+        modes: mode_shapes(cap, extras),
+        worst_places: Vec::new(),
+        quantities: ageing_quantities(cap, extras),
+    };
+    input.worst_places = worst_places(cap, &input);
+    input
+}
+
+/// The time of each path point: the arrival time of its waypoint in the plan, or (without a
+/// plan, or for a point the plan does not list) the time of the point before plus the distance
+/// over the print speed.
+fn timeline(cap: &Cap, extras: &ReportExtras) -> Timeline {
+    let planned: HashMap<(i64, usize), f64> = extras
+        .waypoint_times
+        .iter()
+        .map(|&(l, i, t)| ((l, i), t))
+        .collect();
+    let speed = cap.design.print.print_speed.max(1e-9);
+    let mut point_time = Vec::with_capacity(cap.path.points.len());
+    let mut last: Option<(f64, [f64; 3])> = None;
+    for p in &cap.path.points {
+        let xyz = v3(&p.tip);
+        let walked = last.map_or(0.0, |(t, q)| {
+            t + ((xyz[0] - q[0]).powi(2) + (xyz[1] - q[1]).powi(2) + (xyz[2] - q[2]).powi(2)).sqrt()
+                / speed
+        });
+        let t = planned
+            .get(&(i64::from(p.layer), p.index))
+            .copied()
+            .unwrap_or(walked)
+            .max(last.map_or(0.0, |(t, _)| t));
+        point_time.push(t);
+        last = Some((t, xyz));
+    }
+    let end = point_time.last().copied().unwrap_or(0.0);
+    Timeline {
+        point_time,
+        total_time: extras.plan_end.unwrap_or(end).max(end),
+    }
+}
+
+/// For every bead node (print order), its layer's print index and its index in that layer.
+fn bead_index(cap: &Cap) -> (HashMap<i32, usize>, Vec<usize>) {
+    let by_id = cap
+        .sections
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (l.id, k))
+        .collect();
+    let mut first = Vec::with_capacity(cap.sections.layers.len() + 1);
+    let mut n = 0;
+    for l in &cap.sections.layers {
+        first.push(n);
+        n += l.nodes.len();
+    }
+    first.push(n);
+    (by_id, first)
+}
+
+/// Global bead node nearest to network node `ni` of `net`, within its layer.
+fn nearest_bead(
+    cap: &Cap,
+    by_id: &HashMap<i32, usize>,
+    first: &[usize],
+    net: &crate::states::Network,
+    ni: usize,
+) -> Option<usize> {
+    let node = net.nodes.get(ni)?;
+    let k = *by_id.get(&node.layer)?;
+    let layer = cap.sections.layers.get(k)?;
+    let (j, _) = layer
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(j, b)| (j, (b.xyz - node.xyz).norm()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(first.get(k)? + j)
+}
+
+/// Mode 1 of every analysed state on the bead nodes of its printed layers (see the module docs).
+/// A state whose network cannot be rebuilt is left out (the page then shows the previous mode).
+fn mode_shapes(cap: &Cap, extras: &ReportExtras) -> Vec<ModeShape> {
+    let (by_id, first) = bead_index(cap);
+    let phi = cap.design.print.start_arch_fraction;
+    extras
+        .modes
+        .iter()
+        .filter_map(|(q, blf, mode)| {
+            let state = cap.states.get(*q)?;
+            let net = crate::states::build_state(&cap.sections, &cap.frame, phi, state.index)
+                .ok()?
+                .network;
+            let n = *first.get(state.layers_printed)?;
+            let mut displacement = vec![[0.0; 3]; n];
+            for (ni, u) in mode {
+                if let Some(slot) = nearest_bead(cap, &by_id, &first, &net, *ni)
+                    .and_then(|b| displacement.get_mut(b))
+                {
+                    *slot = *u;
+                }
+            }
+            Some(ModeShape {
+                state: *q,
+                blf: *blf,
+                displacement,
+            })
+        })
+        .collect()
+}
+
+/// With layer ageing: the age (min) and the modulus (MPa) of every printed layer in every state.
+fn ageing_quantities(cap: &Cap, extras: &ReportExtras) -> Vec<Quantity> {
+    let Some(ageing) = extras.ageing else {
+        return Vec::new();
+    };
+    let speed = cap.design.print.print_speed;
+    let ages: Vec<Vec<f64>> = cap
+        .states
+        .iter()
+        .map(|s| {
+            crate::analysis::ageing::layer_ages(&cap.sections, speed, s.layers_printed - 1)
+                .into_iter()
+                .map(|(_, t)| t)
+                .collect()
+        })
+        .collect();
+    let moduli = ages
+        .iter()
+        .map(|a| a.iter().map(|&t| ageing.modulus(t)).collect())
+        .collect();
+    vec![
+        Quantity {
+            key: "layer_age".into(),
+            label: "layer age".into(),
+            unit: "min".into(),
+            to_unit: 1.0 / 60.0,
+            per: QuantityPer::Layer,
+            diverging: false,
+            states: ages,
+            note: Some("time since the layer was printed, at the print speed (as the buckling analysis ages it)".into()),
+        },
+        Quantity {
+            key: "layer_modulus".into(),
+            label: "layer stiffness E".into(),
+            unit: "MPa".into(),
+            to_unit: 1e-6,
+            per: QuantityPer::Layer,
+            diverging: false,
+            states: moduli,
+            note: Some("Young's modulus of the green layer at its age (linear ageing)".into()),
+        },
+    ]
+}
+
+/// Where each state-dependent constraint of `input` is worst (see the module docs).
+fn worst_places(cap: &Cap, input: &ReportInput) -> Vec<WorstPlace> {
+    {
+        let phi = cap.design.print.start_arch_fraction;
+        let areas = cap.areas();
+        let mut places = Vec::new();
+        for row in &input.constraints {
+            let Some(q) = row.state else { continue };
+            let Some(state) = cap.states.get(q) else {
+                continue;
+            };
+            let place = match row.name.as_str() {
+                "sigma_min" | "sigma_max" => {
+                    let Ok(st) =
+                        crate::states::build_state(&cap.sections, &cap.frame, phi, state.index)
+                    else {
+                        continue;
+                    };
+                    let Ok(stresses) = crate::analysis::element_stresses(&st, areas) else {
+                        continue;
+                    };
+                    let pick = if row.name == "sigma_min" {
+                        stresses.iter().min_by(|a, b| a.stress.total_cmp(&b.stress))
+                    } else {
+                        stresses.iter().max_by(|a, b| a.stress.total_cmp(&b.stress))
+                    };
+                    pick.and_then(|e| {
+                        let a = st.network.nodes.get(e.nodes[0])?;
+                        let b = st.network.nodes.get(e.nodes[1])?;
+                        let m = (a.xyz + b.xyz) * 0.5;
+                        Some(WorstPlace {
+                            constraint: row.name.clone(),
+                            state: Some(q),
+                            layer: Some(a.layer.max(b.layer)),
+                            position: v3(&m),
+                            signed_value: None,
+                        })
+                    })
+                }
+                "overhang_max" => cap.sections.layers.get(q).and_then(|l| {
+                    let crown = l.nodes.iter().max_by(|a, b| a.xyz.z.total_cmp(&b.xyz.z))?;
+                    Some(WorstPlace {
+                        constraint: row.name.clone(),
+                        state: Some(q),
+                        layer: Some(l.id),
+                        position: v3(&crown.xyz),
+                        signed_value: cap.overhangs.get(q).map(|o| o * 1e3),
+                    })
+                }),
+                "blf_min" => input.modes.iter().find(|m| m.state == q).and_then(|m| {
+                    let (b, _) = m
+                        .displacement
+                        .iter()
+                        .enumerate()
+                        .map(|(i, d)| (i, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
+                        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+                    let p = input.layers.iter().flat_map(|l| l.nodes.iter()).nth(b)?;
+                    let (_, first) = bead_index(cap);
+                    let k = first.iter().rposition(|&f| f <= b)?;
+                    Some(WorstPlace {
+                        constraint: row.name.clone(),
+                        state: Some(q),
+                        layer: input.layers.get(k).map(|l| l.id),
+                        position: *p,
+                        signed_value: None,
+                    })
+                }),
+                _ => None,
+            };
+            places.extend(place);
+        }
+        places
     }
 }
 
@@ -495,6 +838,94 @@ mod tests {
             .zip(&report_input(&cap, &ReportExtras::default()).states)
         {
             assert_eq!(s.ok, p.ok, "state {}", s.index);
+        }
+    }
+
+    #[test]
+    fn modes_places_and_timeline_follow_the_analysis() {
+        let cap = cheap_cap();
+        let options = crate::analysis::AnalysisOptions::default();
+        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let extras = extras_from_analysis(&analysis);
+        let input = report_input(&cap, &extras);
+        input.validate().unwrap();
+
+        // Every analysed state with a factor has its mode on the bead nodes; not all zero.
+        let analysed = analysis.states.iter().filter(|s| s.blf.is_some()).count();
+        assert!(analysed > 0);
+        assert_eq!(input.modes.len(), analysed);
+        // The mapping copies translations: the largest one on the bead nodes is the largest of
+        // the shell mode (every shell node of a row is a bead node of its layer).
+        let norm = |d: &[f64; 3]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        for m in &input.modes {
+            let bead = m.displacement.iter().map(norm).fold(0.0, f64::max);
+            let shell = analysis.states[m.state]
+                .mode
+                .iter()
+                .map(|(_, d)| norm(d))
+                .fold(0.0, f64::max);
+            assert!(shell > 0.0);
+            assert!((bead - shell).abs() <= 1e-12 * shell, "{bead} vs {shell}");
+        }
+
+        // The BLF place is the peak of the governing mode: in the layer where the analysis
+        // says mode 1 peaks (its element text), on a bead node of that layer.
+        let row = input
+            .constraints
+            .iter()
+            .find(|c| c.name == "blf_min")
+            .unwrap();
+        let place = input
+            .worst_places
+            .iter()
+            .find(|w| w.constraint == "blf_min")
+            .unwrap();
+        let layer = place.layer.unwrap();
+        let text = row.element.as_deref().unwrap();
+        assert!(
+            text.contains(&format!("layer {layer} ")),
+            "{text} vs layer {layer}"
+        );
+        let bead = input.layers.iter().find(|l| l.id == layer).unwrap();
+        assert!(bead.nodes.contains(&place.position));
+
+        // σ_min's place is the midpoint of an element of the worst state in the named layer:
+        // within half a path sampling step (20 mm) plus the bed joint's length of a bead node.
+        let row = input
+            .constraints
+            .iter()
+            .find(|c| c.name == "sigma_min")
+            .unwrap();
+        let place = input
+            .worst_places
+            .iter()
+            .find(|w| w.constraint == "sigma_min")
+            .unwrap();
+        assert_eq!(place.state, row.state);
+        let near = input
+            .layers
+            .iter()
+            .flat_map(|l| l.nodes.iter())
+            .map(|p| {
+                ((p[0] - place.position[0]).powi(2)
+                    + (p[1] - place.position[1]).powi(2)
+                    + (p[2] - place.position[2]).powi(2))
+                .sqrt()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(near <= 0.02, "{near}");
+
+        // Without a plan the timeline walks the path at the print speed: Δt = |Δx| / v.
+        let t = input.timeline.as_ref().unwrap();
+        let v = cap.design.print.print_speed;
+        for (i, w) in input.print_path.points.windows(2).enumerate() {
+            let d = ((w[1][0] - w[0][0]).powi(2)
+                + (w[1][1] - w[0][1]).powi(2)
+                + (w[1][2] - w[0][2]).powi(2))
+            .sqrt();
+            let dt = t.point_time[i + 1] - t.point_time[i];
+            // Sums of f64 times of ~100 s: 1e-9 s is far above their round-off.
+            assert!((dt - d / v).abs() < 1e-9, "{dt} vs {}", d / v);
         }
     }
 }

@@ -137,6 +137,7 @@
     ...q,
     pool: f32(q.pool),
     offsets: i32(q.offsets),
+    scales: f32(q.scales),
   }));
   // Offset of state s's first chunk in a quantity's `offsets` (cumulative printed layers).
   const stateChunk0 = [0];
@@ -251,8 +252,7 @@
       const smax = cmax ? kpaToPa(cmax) : 0;
       const tiny = 1e-6 * Math.max(Math.abs(stress.q.min), Math.abs(stress.q.max));
       const util = (v) => (v < 0 ? (smin < 0 ? v / smin : 0) : v <= tiny ? 0 : smax > 0 ? v / smax : 1.5);
-      let maxU = 0;
-      for (const v of stress.q.pool) maxU = Math.max(maxU, util(v));
+      const maxU = Math.max(util(stress.q.min), util(stress.q.max));
       const hi = Math.max(1.2, Math.min(maxU, 1.5));
       schemes.push({
         key: 'utilisation',
@@ -283,9 +283,11 @@
   function quantityValue(q, s, k, g) {
     const st = data.states[s];
     if (!q.shared && k >= st.layers_printed) return NaN;
-    const chunk = q.offsets[(q.shared ? 0 : stateChunk0[s]) + k];
+    const e = (q.shared ? 0 : stateChunk0[s]) + k;
+    const chunk = q.offsets[e];
     if (chunk === undefined) return NaN;
-    return q.per === 'layer' ? q.pool[chunk] : q.pool[chunk + (g - layerSeg0[k])];
+    const c = q.scales[e];
+    return c * (q.per === 'layer' ? q.pool[chunk] : q.pool[chunk + (g - layerSeg0[k])]);
   }
 
   function drawLegend() {
@@ -769,10 +771,14 @@
   }
   function fitBox() {
     const box = capBox();
+    // The arm, not the mobile base under it: the cap stays large in the frame.
     if (view.robot && view.robot.group.visible) {
       view.robot.group.updateMatrixWorld(true);
-      const rb = new THREE.Box3().setFromObject(view.robot.group);
-      if (!rb.isEmpty()) box.union(rb);
+      for (const o of view.robot.links || view.robot.caps.flatMap((c) => [c.cyl, c.s0, c.s1])) {
+        if (!o) continue;
+        const rb = new THREE.Box3().setFromObject(o);
+        if (!rb.isEmpty()) box.union(rb);
+      }
     }
     return box;
   }

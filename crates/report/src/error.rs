@@ -71,6 +71,12 @@ pub enum ReportError {
         /// The backend's message.
         message: String,
     },
+    /// A page's scene island lacks a field or holds a malformed one.
+    #[error("the report's scene island has no valid {field}")]
+    Island {
+        /// Path of the field.
+        field: String,
+    },
     /// The scene data could not be serialised.
     #[error("scene data could not be serialised to JSON: {0}")]
     Json(#[from] serde_json::Error),

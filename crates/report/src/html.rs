@@ -197,7 +197,7 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
          <output id=\"time-label\" for=\"timeline\"></output></div>\n\
          <div class=\"controls\">\
          <label><input type=\"checkbox\" id=\"show-mode\"> buckling mode</label>\
-         <label>scale <input type=\"range\" id=\"mode-scale\" min=\"1\" max=\"100\" value=\"30\" aria-label=\"mode shape scale\"></label>\
+         <label>scale <input type=\"range\" id=\"mode-scale\" min=\"1\" max=\"100\" value=\"50\" aria-label=\"mode shape scale\"></label>\
          <label><input type=\"checkbox\" id=\"show-markers\" checked> worst places</label>\
          <label><input type=\"checkbox\" id=\"show-beads\" checked> beads</label>\
          <label><input type=\"checkbox\" id=\"show-top\" checked> current layer path</label>\

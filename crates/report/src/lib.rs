@@ -54,6 +54,7 @@ pub use input::{
     PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Series, Station,
     Timeline, Vec3, WorstPlace,
 };
+pub use island::read_island;
 pub use plots::{
     CursorAxis, PLOT_SIZE, PlotFrame, PlotSpec, ReferenceLine, RenderedPlot, VerticalMarker,
     fmt_num, render_plot, render_svg, standard_plots,

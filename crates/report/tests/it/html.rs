@@ -98,15 +98,20 @@ fn data_island_parses_back() {
             .map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect()
     };
+    let scales = f32s(&q["scales"]);
     let mut k = 0;
     for st in &input.states {
         let values = st.segment_stress.as_ref().unwrap();
+        // Chunks proportional to a stored one: within 1e-7 of the largest value, plus f32
+        // rounding of the value and of the scale (2e-7 of the largest covers both).
+        let big = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let mut at = 0;
         for l in input.layers.iter().take(st.layers_printed) {
             let o = usize::try_from(offsets[k]).unwrap();
+            let c = f64::from(scales[k]);
             for j in 0..l.segment_stress.len() {
                 let want = values[at + j];
-                assert!((f64::from(pool[o + j]) - want).abs() <= 6e-8 * want.abs());
+                assert!((f64::from(pool[o + j]) * c - want).abs() <= 2e-7 * big);
             }
             at += l.segment_stress.len();
             k += 1;
@@ -213,4 +218,54 @@ fn round_off_stress_reads_zero_and_rows_link_to_places() {
     assert!(!table.contains("2.798e-12"));
     // The demo gives places for sigma_min and blf: those rows are links.
     assert_eq!(html.matches("class=\"pass-row link\"").count(), 2);
+}
+
+#[test]
+fn island_reads_back_into_a_valid_input() {
+    let input = demo_input();
+    let html = render_html(&input).unwrap();
+    let back = kappe_report::read_island(island(&html)).unwrap();
+    back.validate().unwrap();
+    assert_eq!(back.layers.len(), input.layers.len());
+    assert_eq!(back.states.len(), input.states.len());
+    assert_eq!(back.modes.len(), input.modes.len());
+    // The cell is plain JSON: 7 significant digits.
+    let (ca, cb) = (back.cell.unwrap(), input.cell.unwrap());
+    assert_eq!(ca.stations.len(), cb.stations.len());
+    assert_eq!(ca.stations[1].layers, cb.stations[1].layers);
+    assert!(
+        (ca.stations[1].world_from_base[1][3] - cb.stations[1].world_from_base[1][3]).abs() < 1e-6
+    );
+    // f32 storage: relative error ≤ 2^-24 ≈ 6e-8 per value; a stress chunk kept as a multiple
+    // of another is within 1e-7 of its largest magnitude, plus the f32 rounding of both factors
+    // (2e-7 of the state's largest stress covers it).
+    let close = |a: f64, b: f64| (a - b).abs() <= 6e-8 * b.abs();
+    for (a, b) in back.states.iter().zip(&input.states) {
+        let (sa, sb) = (
+            a.segment_stress.as_ref().unwrap(),
+            b.segment_stress.as_ref().unwrap(),
+        );
+        assert_eq!(sa.len(), sb.len());
+        let big = sb.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(sa.iter().zip(sb).all(|(x, y)| (x - y).abs() <= 2e-7 * big));
+    }
+    let (ra, rb) = (back.robot.unwrap(), input.robot.unwrap());
+    assert_eq!(ra.station, rb.station);
+    assert!(ra.times.iter().zip(&rb.times).all(|(x, y)| close(*x, *y)));
+    // Mode shapes: normalised to max |u| = 1 and quantised in steps of 1/127.
+    let m = &back.modes[5];
+    let src = &input.modes[5].displacement;
+    let max = src
+        .iter()
+        .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+        .fold(0.0, f64::max);
+    for (a, b) in m.displacement.iter().zip(src) {
+        for k in 0..3 {
+            // Half a step of rounding, plus the 1 % cut-off outside the stored node range.
+            assert!(
+                (a[k] - b[k] / max).abs() <= 0.5 / 127.0 + 0.01,
+                "{a:?} {b:?}"
+            );
+        }
+    }
 }
