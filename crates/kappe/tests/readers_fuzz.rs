@@ -11,7 +11,7 @@ use serde_json::Value;
 fn config() -> Config {
     Config {
         cases: 256,
-        rng_seed: RngSeed::Fixed(0x6b61_7070_65),
+        rng_seed: RngSeed::Fixed(0x006b_6170_7065),
         failure_persistence: None,
         ..Config::default()
     }
