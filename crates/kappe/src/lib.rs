@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod arch;
 pub mod buildability;
 pub mod calibrate;
+pub mod ceiling;
 pub mod design_loop;
 pub mod ends;
 pub mod error;

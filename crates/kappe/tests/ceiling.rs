@@ -1,0 +1,104 @@
+//! A three-bay ceiling end to end at a small size (issue 15): every bay designed, every state
+//! analysed, both halves planned, the ceiling summary and the room's report.
+
+use kappe::ceiling::{BayEnds, CeilingDesign, EXAMPLE_TOML, is_ceiling_toml, run_ceiling};
+
+const SMALL: &str = r#"
+name = "small room"
+[ceiling]
+length = 0.5
+ends = "both_walls"
+rise_ratio = 0.25
+[[bay]]
+span = 0.4
+[[bay]]
+span = 0.5
+[[bay]]
+name = "narrow"
+span = 0.35
+[print]
+path_sampling = 0.04
+"#;
+
+#[test]
+fn three_bay_ceiling_end_to_end() {
+    assert!(is_ceiling_toml(SMALL));
+    let c = CeilingDesign::from_toml_str(SMALL).unwrap();
+    assert_eq!(c.bay.len(), 3);
+    let designs = c.bay_designs().unwrap();
+    // Each half: L/2 − Cr·tan(am) − lh/cos(am) (module docs); 1e-12 m round-off.
+    for d in &designs {
+        let am = d.tilt();
+        let expect = 0.25 - d.cap.rise * am.tan() - d.print.layer_height / am.cos();
+        assert!((d.cap.length - expect).abs() < 1e-12);
+        assert_eq!(d.cap.end, kappe::ends::EndKind::EndWall);
+    }
+    let out = run_ceiling(&c, &kappe::Options::of(&designs[0]), &|_, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert_eq!(out.bays.len(), 3);
+    let s = out.summary();
+    let bays = s["bays"].as_array().unwrap();
+    let mut mass = 0.0;
+    for (b, row) in out.bays.iter().zip(bays) {
+        // Every state analysed, buckling included.
+        let a = b.outcome.analysis.as_ref().unwrap();
+        assert_eq!(a.states.len(), b.outcome.cap.states.len());
+        assert!(a.constraints.iter().all(|c| c.states_checked > 0));
+        // Both halves planned, the second the mirror image of the first (same waypoint count,
+        // targets mirrored in y).
+        let p1 = b.outcome.robot.as_ref().unwrap().as_ref().unwrap();
+        let p2 = b.mirror_plan.as_ref().unwrap().as_ref().unwrap();
+        assert_eq!(p1.waypoint_count(), p2.waypoint_count());
+        let w1 = &p1.stations[0].layers[0].waypoints[0];
+        let w2 = &p2.stations[0].layers[0].waypoints[0];
+        assert!((w1.position[1] + w2.position[1]).abs() < 1e-12);
+        assert_eq!(row["halves"], 2);
+        // Mass is both halves: 2 × the cap's.
+        let m = row["mass_kg"].as_f64().unwrap();
+        assert!((m - 2.0 * b.outcome.cap.path.mass).abs() < 1e-12 * m);
+        mass += m;
+        assert!(row["worst_constraint"]["name"].is_string());
+        assert!(row["wall_load"]["per_wall_total_n"].is_array());
+        assert!(row["robot"]["stations"].as_u64().unwrap() >= 2);
+    }
+    // Bays side by side: centres at span/2, then + span + beam.
+    let x: Vec<f64> = out.bays.iter().map(|b| b.x_centre).collect();
+    assert!((x[1] - (0.4 + 0.12 + 0.25)).abs() < 1e-12);
+    let total = s["total"]["mass_kg"].as_f64().unwrap();
+    assert!((total - mass).abs() < 1e-9 * mass);
+    let html = out.index_html();
+    assert!(html.contains("bay_3/report.html") && html.contains("narrow"));
+    assert_eq!(s["ok"].as_bool().unwrap(), out.ok);
+    // Every bay's own report renders.
+    for b in &out.bays {
+        assert!(b.outcome.report_html().unwrap().len() > 1000);
+    }
+}
+
+#[test]
+fn example_ceiling_parses_and_bad_input_is_named() {
+    let c = CeilingDesign::from_toml_str(EXAMPLE_TOML).unwrap();
+    assert_eq!(c.bay.len(), 3);
+    assert!(c.bay.iter().all(|b| b.span == 1.2));
+    assert_eq!(c.ceiling.length, 3.0);
+    assert_eq!(c.ceiling.ends, BayEnds::BothWalls);
+    assert!(!is_ceiling_toml("[cap]\nspan = 1.0\n"));
+    let e = CeilingDesign::from_toml_str("[ceiling]\nlength = 3.0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("bay"), "{e}");
+    let e = CeilingDesign::from_toml_str("[ceiling]\nlength = 0.1\n[[bay]]\nspan = 1.2\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("ceiling.length"), "{e}");
+    let e = CeilingDesign::from_toml_str("[[bay]]\nspan = 1.2\nrize = 0.3\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("rise"), "did-you-mean: {e}");
+    let e = CeilingDesign::from_toml_str("[[bay]]\nspan = -1.0\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("cap.span") && e.contains("bay 1"), "{e}");
+}
