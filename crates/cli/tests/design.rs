@@ -36,7 +36,9 @@ fn design_writes_every_output_and_init_round_trips() {
         "cap.obj",
         "cap.glb",
         "trajectory.csv",
-        "program.script",
+        "plan.json",
+        "programs.json",
+        "program_part01.script",
         "report.html",
     ] {
         assert!(out.join(f).metadata().unwrap().len() > 0, "{f} missing");
@@ -223,4 +225,130 @@ fn check_trajectory_against_path(out: &std::path::Path, summary: &serde_json::Va
         targets.len(),
         "not every path point has a waypoint"
     );
+}
+
+/// A cheap design (3 centre layers of 15 mm, 13 states) that fails by stress: σ_min = −12 kPa
+/// against ~15.4 kPa of arch compression at the springing.
+const FAILING: &str = "[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n\
+                       [constraints]\nsigma_min = -12e3\noverhang_max = 0.03\n[analysis]\nstates = \"every:1000\"\n";
+
+fn scripts(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("program") && n.ends_with(".script"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_failing_design_writes_its_report_but_no_robot_program_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = dir.path().join("fail.toml");
+    std::fs::write(&toml, FAILING).unwrap();
+    let out = dir.path().join("out");
+    let o = kappe()
+        .arg("design")
+        .arg(&toml)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(out.join("report.html").is_file());
+    assert!(scripts(&out).is_empty(), "{:?}", scripts(&out));
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["ok"], false);
+    assert_eq!(
+        s["robot"]["planned"], true,
+        "the plan itself succeeds: {}",
+        s["robot"]
+    );
+    assert_eq!(s["robot_programs_written"], false);
+    assert!(
+        s["robot_programs_why"]
+            .as_str()
+            .unwrap()
+            .contains("--allow-fail"),
+        "{}",
+        s["robot_programs_why"]
+    );
+    // One print time: the plan's, in the summary and on the robot line.
+    let plan_time = s["robot"]["total_time_s"].as_f64().unwrap();
+    assert_eq!(s["print_time_s"].as_f64(), Some(plan_time));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let minutes = format!("{:.1}", plan_time / 60.0);
+    let table_line = stdout
+        .lines()
+        .find(|l| l.contains("print time [min]"))
+        .unwrap();
+    assert!(table_line.ends_with(&minutes), "{table_line} vs {minutes}");
+    assert!(stdout.contains(&format!(", {minutes} min,")), "{stdout}");
+
+    // --allow-fail: status 0, the programs, and warnings rather than errors.
+    let out2 = dir.path().join("out2");
+    let o = kappe()
+        .arg("design")
+        .arg(&toml)
+        .arg("--out")
+        .arg(&out2)
+        .arg("--allow-fail")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("error:"), "{stderr}");
+    assert!(
+        stderr.contains("warning: constraint sigma_min fails"),
+        "{stderr}"
+    );
+    assert!(!scripts(&out2).is_empty());
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out2.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["robot_programs_written"], true);
+    assert!(s["robot_programs_why"].is_null());
+}
+
+/// `summary.json` of `kappe design` is the library's `Outcome::summary()` for the same design
+/// and options, key for key and number for number (serialized the same way); only the
+/// wall-clock `analysis_timings_s` differ between two runs.
+#[test]
+fn summary_json_is_the_library_outcome_summary() {
+    let dir = tempfile::tempdir().unwrap();
+    let toml = dir.path().join("d.toml");
+    std::fs::write(&toml, FAILING).unwrap();
+    let out = dir.path().join("out");
+    let o = kappe()
+        .arg("design")
+        .arg(&toml)
+        .arg("--out")
+        .arg(&out)
+        .arg("-q")
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let mut cli: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+
+    let design = kappe::Design::from_toml_str(FAILING).unwrap();
+    let outcome = kappe::run(&design, &kappe::Options::of(&design), &kappe::no_progress).unwrap();
+    // Through the same bytes as the CLI writes them.
+    let mut lib: serde_json::Value =
+        serde_json::from_slice(&serde_json::to_vec_pretty(&outcome.summary()).unwrap()).unwrap();
+    for v in [&mut cli, &mut lib] {
+        v.as_object_mut().unwrap().remove("analysis_timings_s");
+    }
+    assert_eq!(cli, lib);
 }

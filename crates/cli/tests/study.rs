@@ -119,9 +119,11 @@ fn grid_reproduces_kappe_design_row_by_row() {
     let tmp = tempfile::tempdir().unwrap();
     let work = tmp.path();
     std::fs::write(work.join("grid.toml"), grid_study()).unwrap();
+    // The grid holds failing designs, so the study exits 1 (`kappe --help`).
     let run = kappe(&["study", "grid.toml", "--out", "s", "--quiet"], work);
-    assert!(
-        run.status.success(),
+    assert_eq!(
+        run.status.code(),
+        Some(1),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
@@ -244,8 +246,15 @@ fn shards_merged_equal_the_unsharded_study() {
     let tmp = tempfile::tempdir().unwrap();
     let work = tmp.path();
     std::fs::write(work.join("grid.toml"), grid_study()).unwrap();
+    // The grid holds failing designs: its runs and merges exit 1 ("some designs failed"), and
+    // would exit 2 or 3 for a usage or I/O error.
     let ok = |o: Output| {
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         o
     };
     // The robot is not what shards are about: skip planning to keep the test quick.
@@ -281,8 +290,14 @@ fn shards_merged_equal_the_unsharded_study() {
         ],
         work,
     ));
-    let a = tree(&work.join("all"));
-    let b = tree(&work.join("merged"));
+    // The output manifest (`.kappe-output.json`, Kappe's marker of its own directories) names
+    // the command that wrote it; every other file must be byte-identical.
+    let manifest = |mut t: BTreeMap<PathBuf, Vec<u8>>| {
+        t.remove(Path::new(".kappe-output.json"));
+        t
+    };
+    let a = manifest(tree(&work.join("all")));
+    let b = manifest(tree(&work.join("merged")));
     assert_eq!(
         a.keys().collect::<Vec<_>>(),
         b.keys().collect::<Vec<_>>(),
@@ -454,4 +469,102 @@ fn an_analysis_table_adds_the_buckling_factor() {
         .map(|(i, _)| i)
         .collect();
     assert_eq!(with_blf, [states.len() - 1]);
+}
+
+#[test]
+fn a_study_analyses_as_kappe_design_and_its_design_files_reproduce_the_verdict() {
+    let tmp = tempfile::tempdir().unwrap();
+    let work = tmp.path();
+    // Two cheap designs (13 states). Without [analysis] the study must check buckling as
+    // `kappe design` does by default. BLF_min = 1e9 cannot be met by any shell (the factors are
+    // O(10–100) for these caps), so "b" fails by buckling alone; "a" keeps BLF_min = 1.
+    std::fs::write(
+        work.join("no-table.toml"),
+        "[base]
+cap.length = 0.05
+print.layer_height = 0.015
+constraints.overhang_max = 0.03
+         [grid]
+\"constraints.blf_min\" = [1.0, 1e9]
+",
+    )
+    .unwrap();
+    let run = kappe(
+        &["study", "no-table.toml", "--out", "s", "-q", "--no-robot"],
+        work,
+    );
+    assert_eq!(
+        run.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let rows = read_csv(&work.join("s/study.csv"));
+    assert_eq!(rows.len(), 2);
+    for row in &rows {
+        let blf: f64 = row["min_blf"].parse().unwrap();
+        assert!(blf > 1.0, "{}: BLF {blf}", row["name"]);
+    }
+    let result = |name: &str| {
+        rows.iter()
+            .find(|r| r["constraints.blf_min"] == name)
+            .unwrap()["result"]
+            .clone()
+    };
+    assert_eq!(result("1.0"), "pass");
+    assert_eq!(result("1000000000.0"), "fail");
+
+    // With an [analysis] table (buckling off) that table goes into every design.toml, so the
+    // design run alone reaches the study's verdict: "b" passes without buckling.
+    std::fs::write(
+        work.join("table.toml"),
+        std::fs::read_to_string(work.join("no-table.toml"))
+            .unwrap()
+            .replace("[grid]", "[analysis]\nbuckling = false\n[grid]"),
+    )
+    .unwrap();
+    let run = kappe(
+        &["study", "table.toml", "--out", "t", "-q", "--no-robot"],
+        work,
+    );
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for (dir, expect_blf) in [("s", true), ("t", false)] {
+        for row in read_csv(&work.join(dir).join("study.csv")) {
+            let design = work
+                .join(dir)
+                .join("designs")
+                .join(&row["name"])
+                .join("design.toml");
+            let text = std::fs::read_to_string(&design).unwrap();
+            assert_eq!(text.contains("buckling = false"), !expect_blf, "{text}");
+            let out = work.join(format!("alone-{dir}-{}", row["name"]));
+            let alone = kappe(
+                &[
+                    "design",
+                    design.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                    "-q",
+                    "--no-robot",
+                ],
+                work,
+            );
+            let code = alone.status.code();
+            assert_eq!(
+                code == Some(0),
+                row["result"] == "pass",
+                "{dir}/{}: kappe design exits {code:?}, the study says {}",
+                row["name"],
+                row["result"]
+            );
+            let s: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+            assert_eq!(s["ok"].as_bool(), Some(row["result"] == "pass"));
+        }
+    }
 }

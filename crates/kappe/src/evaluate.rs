@@ -24,6 +24,9 @@ pub struct Options {
     pub analysis: Option<AnalysisOptions>,
     /// Plan the robot, for designs whose `robot.enabled` is set.
     pub robot: bool,
+    /// Hand out the robot programs of a design that fails its checks too (`--allow-fail`);
+    /// without it a failing design has a plan but no programs ([`Outcome::programs`]).
+    pub allow_fail: bool,
 }
 
 impl Options {
@@ -33,6 +36,7 @@ impl Options {
         Options {
             analysis: Some(design.analysis.clone()),
             robot: true,
+            allow_fail: false,
         }
     }
 }
@@ -126,6 +130,8 @@ pub struct Outcome {
     pub extras: ReportExtras,
     /// The verdict of [`crate::verdict::design_ok`].
     pub ok: bool,
+    /// [`Options::allow_fail`] of the run.
+    pub allow_fail: bool,
 }
 
 /// Form-find `design`, then [`evaluate`] it. `on_progress` hears every state solved, every
@@ -199,6 +205,7 @@ fn evaluate_until(
         robot,
         extras,
         ok,
+        allow_fail: options.allow_fail,
     })
 }
 
@@ -219,11 +226,50 @@ impl Outcome {
                 serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
             }
         };
+        let programs = self.programs();
         if let Some(obj) = summary.as_object_mut() {
+            obj.insert("print_time_s".into(), serde_json::json!(self.print_time()));
             obj.insert("robot".into(), robot);
+            obj.insert(
+                "robot_programs_written".into(),
+                serde_json::json!(programs.is_ok()),
+            );
+            obj.insert(
+                "robot_programs_why".into(),
+                serde_json::json!(programs.err()),
+            );
             obj.insert("ok".into(), serde_json::json!(self.ok));
         }
         summary
+    }
+
+    /// The print time, s, computed once for the table, the robot line, the summary and the
+    /// study row: the robot plan's total time (printing, layer changes, station changes) when
+    /// there is a plan, else the path length over the print speed plus the layer changes
+    /// ([`crate::path::PrintPath::time`]).
+    pub fn print_time(&self) -> f64 {
+        match &self.robot {
+            Some(Ok(plan)) => plan.total_time,
+            _ => self.cap.path.time,
+        }
+    }
+
+    /// The plan whose robot programs may be written: there is one and the design passes, or
+    /// [`Options::allow_fail`] was given. Otherwise why not, in words (for the summary).
+    ///
+    /// # Errors
+    /// The reason when no programs are to be written.
+    pub fn programs(&self) -> Result<&kappe_robot::Plan, String> {
+        match &self.robot {
+            None => Err("robot planning was not run".into()),
+            Some(Err(e)) => Err(format!("the robot cannot print this design: {e}")),
+            Some(Ok(_)) if !self.ok && !self.allow_fail => Err(
+                "the design fails its checks; rerun with --allow-fail (Python: allow_fail=True) \
+                 to write the programs anyway"
+                    .into(),
+            ),
+            Some(Ok(plan)) => Ok(plan),
+        }
     }
 
     /// The input of the HTML report ([`crate::report_input::report_input`]).

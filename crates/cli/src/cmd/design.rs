@@ -1,28 +1,34 @@
-//! `kappe design` and `kappe init`.
+//! `kappe design`: parse, call `kappe::run`, show progress, write the output directory.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::output::{write_dir_atomic, write_file_atomic};
+use crate::exit::Usage;
+use crate::output::prepare_dir;
 
 #[derive(Args)]
 pub struct DesignArgs {
     /// Design file (TOML); the embedded default design when omitted (`kappe init` writes it).
     pub design: Option<PathBuf>,
-    /// Output directory (replaced atomically: nothing is written on error).
+    /// Output directory: created, or replaced if it is a previous Kappe output (swapped in
+    /// atomically when complete; nothing is written on error). Never the working directory.
     #[arg(long, short, default_value = "out")]
     pub out: PathBuf,
+    /// Also replace a non-empty directory that is not a Kappe output, by moving it aside to
+    /// `DIR.old-N` (nothing is deleted).
+    #[arg(long)]
+    pub force: bool,
     /// No progress bar and no table.
     #[arg(long, short)]
     pub quiet: bool,
     /// Print the summary as JSON to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Skip robot motion planning (no trajectory.csv / program.script).
+    /// Skip robot motion planning (no trajectory.csv, plan.json or programs).
     #[arg(long)]
     pub no_robot: bool,
     /// Print states that get a shell buckling analysis: "all", "every:N" or "P%" (stresses and
@@ -35,16 +41,6 @@ pub struct DesignArgs {
     /// Exit with status 0 even when the design fails a constraint or cannot be planned.
     #[arg(long)]
     pub allow_fail: bool,
-}
-
-#[derive(Args)]
-pub struct InitArgs {
-    /// Where to write the example design.
-    #[arg(default_value = "kappe.toml")]
-    pub path: PathBuf,
-    /// Overwrite an existing file.
-    #[arg(long)]
-    pub force: bool,
 }
 
 pub fn run(args: DesignArgs) -> Result<ExitCode> {
@@ -63,7 +59,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         if let Some(states) = &args.states {
             analysis.states = states
                 .parse()
-                .map_err(|e| anyhow::anyhow!("--states: {e}"))?;
+                .map_err(|e| Usage(format!("--states: {e}")))?;
         }
         if args.no_buckling {
             analysis.buckling = false;
@@ -71,6 +67,10 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     }
     // Robot: planned (and verified inside the planner) unless disabled.
     options.robot = !args.no_robot;
+    // A failing design gets no robot programs unless asked for (issue 16).
+    options.allow_fail = args.allow_fail;
+    // Refusals and unwritable locations fail here, before any computing.
+    let prepared = prepare_dir(&args.out, args.force, "design")?;
     let silent = args.quiet || args.json;
     let bar = state_bar("print states", silent);
     let fe_bar = state_bar("analysis", silent);
@@ -102,18 +102,24 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     spinner.finish_and_clear();
     let cap = &eval.cap;
     let (analysis, robot, ok) = (&eval.analysis, &eval.robot, eval.ok);
-    let mut programs: Vec<String> = Vec::new();
+    // Robot programs: standalone files of at most the target limit, each passing the
+    // independent URScript check, their index, the trajectory and the plan (for resume).
+    let mut programs: Vec<kappe_robot::ProgramFile> = Vec::new();
     let mut trajectory: Vec<u8> = Vec::new();
-    let mut program: Vec<u8> = Vec::new();
+    let mut plan_json: Vec<u8> = Vec::new();
     if let Some(Ok(plan)) = robot {
         kappe_robot::write_trajectory_csv(plan, &mut trajectory)?;
-        kappe_robot::write_urscript(plan, &mut program)?;
-        programs = kappe_robot::urscript_programs(plan)?;
+        kappe_robot::write_plan_json(plan, &mut plan_json)?;
+    }
+    // No programs for a design that fails its checks, unless --allow-fail (issue 16).
+    if let Ok(plan) = eval.programs() {
+        programs = crate::cmd::robot::linted_programs(plan, "program_part")?;
     }
     let report = eval.report_html()?;
     let summary = eval.summary();
     let network = kappe::export::network_json(cap)?;
-    write_dir_atomic(&args.out, |dir| {
+    {
+        let dir = prepared.path();
         std::fs::write(
             dir.join("summary.json"),
             serde_json::to_vec_pretty(&summary)?,
@@ -128,47 +134,61 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         std::fs::write(dir.join("report.html"), &report)?;
         if !trajectory.is_empty() {
             std::fs::write(dir.join("trajectory.csv"), &trajectory)?;
+            std::fs::write(dir.join("plan.json"), &plan_json)?;
         }
-        if !program.is_empty() {
-            std::fs::write(dir.join("program.script"), &program)?;
+        // Programs that fit the controller, run in the order of programs.json; one combined
+        // program.script only when the whole print fits in one.
+        for p in &programs {
+            std::fs::write(dir.join(&p.name), &p.text)?;
         }
-        // Long programs also come as numbered parts that fit the controller, run in order.
-        if programs.len() > 1 {
-            for (i, p) in programs.iter().enumerate() {
-                std::fs::write(dir.join(format!("program_part{:02}.script", i + 1)), p)?;
-            }
+        if !programs.is_empty() {
+            std::fs::write(
+                dir.join("programs.json"),
+                kappe_robot::index_json(&programs),
+            )?;
         }
-        Ok(())
-    })?;
+        if let [one] = programs.as_slice() {
+            std::fs::write(dir.join("program.script"), &one.text)?;
+        }
+    }
+    if let Some(notice) = prepared.commit()? {
+        eprintln!("note: {notice}");
+    }
 
     if args.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else if !args.quiet {
-        print_table(cap, &args.out);
+        print_table(cap, eval.print_time(), &args.out);
         if let Some(analysis) = analysis {
             print!("{}", indent(&analysis.report()));
         }
         match &robot {
             Some(Ok(plan)) => println!(
-                "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm; \
-                 wrote trajectory.csv, program.script ({} part(s))",
+                "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm, \
+                 {} slowdown(s); wrote trajectory.csv, plan.json{}",
                 plan.stations.len(),
                 plan.joint_motion,
-                plan.total_time / 60.0,
+                eval.print_time() / 60.0,
                 plan.min_clearance * 1e3,
-                programs.len()
+                plan.slowdowns.len(),
+                match eval.programs() {
+                    Ok(_) => format!(", {} program(s) listed in programs.json", programs.len()),
+                    Err(why) => format!("; no programs: {why}"),
+                }
             ),
             Some(Err(e)) => println!("  robot: NOT PLANNED: {e}"),
             None => println!("  robot: planning skipped"),
         }
     }
+    // With --allow-fail a failing design is not an error: its reasons are warnings.
+    let level = if args.allow_fail { "warning" } else { "error" };
     if let Some(Err(e)) = &robot {
-        eprintln!("error: the robot cannot print this design: {e}");
+        eprintln!("{level}: the robot cannot print this design: {e}");
     }
     if !ok {
         for c in analysis.iter().flat_map(|a| a.failing()) {
             eprintln!(
-                "error: constraint {} fails: worst {} {} against the limit {} {}{}",
+                "{level}: constraint {} fails: worst {} {} against the limit {} {}{}",
                 c.name,
                 c.worst.map_or("n/a".into(), |w| format!("{w:.4e}")),
                 c.unit,
@@ -179,7 +199,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
             );
         }
         if !args.allow_fail {
-            return Ok(ExitCode::FAILURE);
+            return Ok(crate::exit::fails());
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -210,7 +230,7 @@ fn indent(text: &str) -> String {
     text.lines().map(|l| format!("  {l}\n")).collect()
 }
 
-fn print_table(cap: &kappe::Cap, out: &std::path::Path) {
+fn print_table(cap: &kappe::Cap, print_time: f64, out: &std::path::Path) {
     let d = &cap.design;
     let last = cap.states.last();
     let worst_c = cap
@@ -282,25 +302,9 @@ fn print_table(cap: &kappe::Cap, out: &std::path::Path) {
     );
     println!("  {:<34} {:>14.2}", "volume [l]", cap.path.volume * 1e3);
     println!("  {:<34} {:>14.1}", "mass [kg]", cap.path.mass);
-    println!(
-        "  {:<34} {:>14.1}",
-        "print time [min]",
-        cap.path.time / 60.0
-    );
+    println!("  {:<34} {:>14.1}", "print time [min]", print_time / 60.0);
     println!(
         "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb, report.html}}",
         out.display()
     );
-}
-
-pub fn init(args: InitArgs) -> Result<ExitCode> {
-    if args.path.exists() && !args.force {
-        bail!(
-            "{} exists; pass --force to overwrite it",
-            args.path.display()
-        );
-    }
-    write_file_atomic(&args.path, kappe::spec::EXAMPLE_TOML.as_bytes())?;
-    println!("wrote {}", args.path.display());
-    Ok(ExitCode::SUCCESS)
 }

@@ -7,13 +7,14 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use kappe::study::{Record, StudyResult, Variation, Verdict};
 use rayon::prelude::*;
 
-use crate::output::write_dir_atomic;
+use crate::exit::Usage;
+use crate::output::prepare_dir;
 
 /// `kappe study`: run a study file, or merge shards.
 #[derive(Args)]
@@ -40,8 +41,10 @@ struct RunArgs {
     #[arg(long, short, required = true)]
     out: Option<PathBuf>,
     /// Run only the designs i, i+n, i+2n, … of the study order (0 ≤ i < n) and write a partial
-    /// result for `kappe study merge`.
-    #[arg(long, value_name = "i/n")]
+    /// result for `kappe study merge`. `--shard` alone (or `--shard slurm`) takes i and n from a
+    /// Slurm job array: i = SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN, n =
+    /// SLURM_ARRAY_TASK_COUNT (docs/python.md has a job script).
+    #[arg(long, value_name = "i/n", num_args = 0..=1, default_missing_value = "slurm")]
     shard: Option<String>,
     /// Number of designs run at the same time (default: one per core).
     #[arg(long, short)]
@@ -53,6 +56,9 @@ struct RunArgs {
     /// No progress bar and no summary.
     #[arg(long, short)]
     quiet: bool,
+    /// Also replace a non-empty directory that is not a Kappe output, by moving it aside.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Args)]
@@ -69,6 +75,9 @@ struct MergeArgs {
     /// No summary.
     #[arg(long, short)]
     quiet: bool,
+    /// Also replace a non-empty directory that is not a Kappe output, by moving it aside.
+    #[arg(long)]
+    force: bool,
 }
 
 pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
@@ -76,6 +85,30 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
         Some(StudyAction::Merge(args)) => merge(args),
         None => run_study(cmd.run),
     }
+}
+
+/// The shard of this task of a Slurm job array (`--shard` without a value).
+fn slurm_shard() -> Result<(usize, usize)> {
+    let var = |k: &str| -> Result<Option<usize>> {
+        match std::env::var(k) {
+            Err(_) => Ok(None),
+            Ok(v) => v.trim().parse().map(Some).map_err(|_| {
+                crate::exit::Usage(format!("--shard: {k}={v:?} is not a whole number")).into()
+            }),
+        }
+    };
+    let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID")?, var("SLURM_ARRAY_TASK_COUNT")?)
+    else {
+        return Err(crate::exit::Usage(
+            "--shard without i/n needs SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT (a Slurm job \
+             array); give --shard i/n otherwise"
+                .into(),
+        )
+        .into());
+    };
+    let min = var("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+    let spec = format!("{}/{count}", id.saturating_sub(min));
+    Ok(kappe::study::parse_shard(&spec)?)
 }
 
 /// Writes `study.json`, `study.csv` and `study.html` into `dir`.
@@ -88,12 +121,7 @@ fn write_study_files(dir: &Path, result: &StudyResult) -> Result<()> {
 }
 
 /// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
-fn run_one(
-    v: &Variation,
-    parameter_paths: &[String],
-    options: &kappe::Options,
-    root: &Path,
-) -> Record {
+fn run_one(v: &Variation, parameter_paths: &[String], no_robot: bool, root: &Path) -> Record {
     let parameters = kappe::study::parameter_values(v, parameter_paths);
     let dir = root.join("designs").join(&v.name);
     if let Err(e) = std::fs::create_dir_all(&dir)
@@ -105,7 +133,7 @@ fn run_one(
             format!("cannot write {}: {e}", dir.display()),
         );
     }
-    let run = kappe::study::run_one(v, parameters.clone(), options);
+    let run = kappe::study::run_one(v, parameters.clone(), no_robot);
     let write = || -> std::io::Result<()> {
         if let Some(summary) = &run.summary {
             std::fs::write(
@@ -150,13 +178,12 @@ fn print_summary(result: &StudyResult, out: &Path) {
 
 fn run_study(args: RunArgs) -> Result<ExitCode> {
     let (Some(path), Some(out)) = (args.study, args.out) else {
-        bail!("give a STUDY.toml and --out DIR");
+        return Err(Usage("give a STUDY.toml and --out DIR".into()).into());
     };
-    let shard = args
-        .shard
-        .as_deref()
-        .map(kappe::study::parse_shard)
-        .transpose()?;
+    let shard = match args.shard.as_deref() {
+        Some("slurm") => Some(slurm_shard()?),
+        other => other.map(kappe::study::parse_shard).transpose()?,
+    };
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("cannot read the study file {}", path.display()))?;
     let source = path.file_name().map_or_else(
@@ -184,34 +211,38 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         let mut builder = rayon::ThreadPoolBuilder::new();
         if let Some(j) = args.jobs {
             if j == 0 {
-                bail!("--jobs 0: give at least 1");
+                return Err(Usage("--jobs 0: give at least 1".into()).into());
             }
             builder = builder.num_threads(j);
         }
         builder.build().context("cannot start the worker threads")?
     };
-    let options = study.options(args.no_robot);
-    let mut result = None;
-    write_dir_atomic(&out, |dir| {
-        std::fs::create_dir_all(dir.join("designs"))?;
-        let rows: Vec<Record> = pool.install(|| {
-            selected
-                .par_iter()
-                .map(|v| {
-                    let r = run_one(v, &study.parameters, &options, dir);
-                    bar.inc(1);
-                    r
-                })
-                .collect()
-        });
-        let r = kappe::study::collect(&study, shard, args.no_robot, rows)?;
-        write_study_files(dir, &r)?;
-        result = Some(r);
-        Ok(())
-    })?;
+    // Refusals and unwritable locations fail here, before any design runs.
+    let prepared = prepare_dir(&out, args.force, "study")?;
+    let dir = prepared.path();
+    std::fs::create_dir_all(dir.join("designs"))?;
+    let rows: Vec<Record> = pool.install(|| {
+        selected
+            .par_iter()
+            .map(|v| {
+                let r = run_one(v, &study.parameters, args.no_robot, dir);
+                bar.inc(1);
+                r
+            })
+            .collect()
+    });
+    let result = kappe::study::collect(&study, shard, args.no_robot, rows)?;
+    write_study_files(dir, &result)?;
+    if let Some(notice) = prepared.commit()? {
+        eprintln!("note: {notice}");
+    }
     bar.finish_and_clear();
-    if let (Some(r), false) = (&result, args.quiet) {
-        print_summary(r, &out);
+    if !args.quiet {
+        print_summary(&result, &out);
+    }
+    // Status 1 when any design fails or could not run (the scheme of `kappe --help`).
+    if result.rows.iter().any(|row| row.outcome != Verdict::Pass) {
+        return Ok(crate::exit::fails());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -258,15 +289,18 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
     let mut parts = Vec::with_capacity(args.dirs.len());
     for dir in &args.dirs {
         if std::path::absolute(dir).is_ok_and(|d| d == out_abs) {
-            bail!(
+            return Err(Usage(format!(
                 "--out {} is also an input; merge into a new directory",
                 args.out.display()
-            );
+            ))
+            .into());
         }
         parts.push((dir.display().to_string(), read_result(dir)?));
     }
     let merged = kappe::study::merge(&parts, args.allow_incomplete)?;
-    write_dir_atomic(&args.out, |dir| {
+    let prepared = prepare_dir(&args.out, args.force, "study merge")?;
+    {
+        let dir = prepared.path();
         for (row, &k) in merged.result.rows.iter().zip(&merged.sources) {
             let from = args.dirs[k].join("designs").join(&row.name);
             if from.is_dir() {
@@ -274,10 +308,21 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
             }
         }
         std::fs::create_dir_all(dir.join("designs"))?;
-        write_study_files(dir, &merged.result)
-    })?;
+        write_study_files(dir, &merged.result)?;
+    }
+    if let Some(notice) = prepared.commit()? {
+        eprintln!("note: {notice}");
+    }
     if !args.quiet {
         print_summary(&merged.result, &args.out);
+    }
+    if merged
+        .result
+        .rows
+        .iter()
+        .any(|row| row.outcome != Verdict::Pass)
+    {
+        return Ok(crate::exit::fails());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -191,7 +191,7 @@ pub fn parse(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
         Some(toml::Value::String(s)) => s.clone(),
         Some(other) => bail!("`title` must be a string, not a {}", other.type_str()),
     };
-    let base = base_table(&doc, study_dir)?;
+    let mut base = base_table(&doc, study_dir)?;
     let analysis = match doc.get("analysis") {
         None => None,
         Some(v) => {
@@ -200,6 +200,9 @@ pub fn parse(text: &str, source: &str, study_dir: &Path) -> Result<Study> {
                     StudyError::File(format!("[analysis]: {}", e.message()))
                 })?;
             o.validate().context("[analysis]")?;
+            // Every design carries the study's analysis (it replaces a base's own), so its
+            // `design.toml` run alone by `kappe design` is analysed, and judged, the same way.
+            base.insert("analysis".into(), v.clone());
             Some(o)
         }
     };

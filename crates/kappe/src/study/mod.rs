@@ -24,10 +24,11 @@
 //! in a design file (a study error, naming the entry), while a value outside its allowed range
 //! makes only that design fail (a row marked failed with the reason).
 //!
-//! An optional `[analysis]` table (the options of [`crate::analysis::analyze`], e.g.
-//! `states = "25%"`, `buckling = false`, `modes = 3`) runs the finite-element analysis on every
-//! design, adding the BLF and its verdict; without it designs are judged on stresses and
-//! overhang only (the preliminary checks of [`crate::verdict::preliminary_constraints`]).
+//! Every design is analysed as `kappe design` analyses it: with its own `[analysis]` options
+//! (by default shell buckling in every state). An optional `[analysis]` table in the study file
+//! (e.g. `states = "25%"`, `buckling = false`, `modes = 3`) replaces them in every design, and
+//! is written into every `designs/<name>/design.toml`, so that `kappe design` on that file alone
+//! reaches the same verdict. (`kappe study --no-robot` corresponds to `kappe design --no-robot`.)
 //!
 //! Grid axes are taken in the alphabetical order of their paths, the last varying fastest;
 //! grid designs are named `<field>=<value>` joined by `_` (e.g. `rise=0.15_span=0.6`).
@@ -116,15 +117,6 @@ pub struct Study {
 }
 
 impl Study {
-    /// What [`run_one`] runs for every design: the study's analysis, and the robot plan unless
-    /// `no_robot`.
-    pub fn options(&self, no_robot: bool) -> crate::Options {
-        crate::Options {
-            analysis: self.analysis.clone(),
-            robot: !no_robot,
-        }
-    }
-
     /// The designs of shard `i` of `n` (those whose index is ≡ i mod n), or all.
     pub fn select(&self, shard: Option<(usize, usize)>) -> Vec<&Variation> {
         self.variations

@@ -60,9 +60,11 @@ pub fn error_record(v: &Variation, parameters: Vec<String>, reason: String) -> R
     }
 }
 
-/// Runs one design through [`crate::run`] with `options`. Never fails: a design out of range,
-/// one that cannot be form-found, or even a panic becomes an error row.
-pub fn run_one(v: &Variation, parameters: Vec<String>, options: &Options) -> DesignRun {
+/// Runs one design through [`crate::run`] as `kappe design` would ([`Options::of`]: the
+/// design's own `[analysis]`, which carries the study's; the robot unless `no_robot`). Never
+/// fails: a design out of range, one that cannot be form-found, or even a panic becomes an error
+/// row.
+pub fn run_one(v: &Variation, parameters: Vec<String>, no_robot: bool) -> DesignRun {
     let failed = |reason: String| DesignRun {
         record: error_record(v, parameters.clone(), reason),
         summary: None,
@@ -73,7 +75,11 @@ pub fn run_one(v: &Variation, parameters: Vec<String>, options: &Options) -> Des
         Err(reason) => return failed(reason.clone()),
     };
     let outcome = std::panic::catch_unwind(AssertUnwindSafe(|| -> Result<DesignRun, String> {
-        let out = crate::run(design, options, &no_progress).map_err(|e| e.to_string())?;
+        let options = Options {
+            robot: !no_robot,
+            ..Options::of(design)
+        };
+        let out = crate::run(design, &options, &no_progress).map_err(|e| e.to_string())?;
         let cap = &out.cap;
         let robot = out
             .robot
@@ -101,7 +107,7 @@ pub fn run_one(v: &Variation, parameters: Vec<String>, options: &Options) -> Des
             max_overhang_m: Some(cap.overhangs.iter().fold(0.0, |m, o| m.max(o.abs()))),
             min_blf: out.min_blf(),
             mass_kg: Some(cap.path.mass),
-            print_time_s: Some(cap.path.time),
+            print_time_s: Some(out.print_time()),
             states: Some(cap.states.len()),
             robot: robot.map(|e| e.map_or_else(|| "ok".into(), |e| format!("failed: {e}"))),
             constraints: input.constraints,
