@@ -37,6 +37,9 @@ fn buckle_vault_fixture() {
         "--modes",
         "3",
         "--mode-shapes",
+        // The exact reference factors are CST+DKT's; the command's default is ANDES+DKMT.
+        "--element",
+        "cst",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let r = read_json(&out);
@@ -73,6 +76,9 @@ fn static_plate_fixture() {
         mesh.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
+        // CST's membrane reproduces N_x = −1 exactly; that is what this test checks.
+        "--element",
+        "cst",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let r = read_json(&out);
@@ -142,4 +148,24 @@ fn bad_mesh_messages() {
     let o = kappe(&["fe", "buckle", mesh.to_str().unwrap()]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("thickness[0] = -0.01"));
+}
+
+/// The default element of `kappe fe` is ANDES+DKMT (issue 17): on the vault fixture it is
+/// closer to CalculiX's converged S8R factor 0.068970 than CST+DKT (+0.48 % against +1.14 % at
+/// this 20×12 mesh, crates/fe README); checked as "below CST+DKT's exact factor, within 1 % of
+/// S8R".
+#[test]
+fn buckle_defaults_to_the_shear_deformable_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("vault.json");
+    let mesh = fixture("vault_s3_20x12.mesh.json");
+    let o = kappe(&["fe", "buckle", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = read_json(&out);
+    assert_eq!(r["solver"]["element_kind"].as_str(), Some("andes_dkmt"));
+    let got = r["factors"][0].as_f64().unwrap();
+    let refs = read_json(&fixture("facet_ref_results.json"));
+    let cst = refs["results"]["vault_s3_20x12"]["lambda"][0].as_f64().unwrap();
+    assert!(got < cst, "{got} vs CST+DKT {cst}");
+    assert!((got / 0.068970 - 1.0).abs() < 0.01, "{got}");
 }

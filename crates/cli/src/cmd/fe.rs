@@ -44,7 +44,8 @@ pub struct BuckleArgs {
     /// Accept triangles oriented against their neighbours (results are orientation-independent).
     #[arg(long)]
     allow_mixed_orientation: bool,
-    /// Element formulation; overrides the mesh's "element" (default there: cst).
+    /// Element formulation; overrides the mesh's "element". Default: the mesh's "element", else
+    /// ANDES + DKMT (shear-deformable, exact Kirchhoff limit; `kappe_fe::element::dkmt`).
     #[arg(long, value_enum)]
     element: Option<ElementArg>,
 }
@@ -52,6 +53,11 @@ pub struct BuckleArgs {
 /// `--element`: the facet element of `kappe_fe::ElementKind`.
 #[derive(Clone, Copy, ValueEnum)]
 enum ElementArg {
+    /// ANDES/OPT membrane + DKMT Reissner–Mindlin plate: transverse shear for thick shells,
+    /// DKT in the thin limit (the default).
+    Dkmt,
+    /// CST membrane + DKMT plate.
+    CstDkmt,
     /// CST membrane + DKT plate + drilling spring (the reference element of the fixtures).
     Cst,
     /// ANDES/OPT membrane with drilling freedoms + DKT plate (better membrane on coarse meshes).
@@ -61,6 +67,8 @@ enum ElementArg {
 impl From<ElementArg> for ElementKind {
     fn from(e: ElementArg) -> Self {
         match e {
+            ElementArg::Dkmt => ElementKind::AndesDkmt,
+            ElementArg::CstDkmt => ElementKind::CstDkmt,
             ElementArg::Cst => ElementKind::CstDkt,
             ElementArg::Andes => ElementKind::AndesDkt,
         }
@@ -81,7 +89,8 @@ pub struct StaticArgs {
     /// element frames then follow each triangle's own normal).
     #[arg(long)]
     allow_mixed_orientation: bool,
-    /// Element formulation; overrides the mesh's "element" (default there: cst).
+    /// Element formulation; overrides the mesh's "element". Default: the mesh's "element", else
+    /// ANDES + DKMT (shear-deformable, exact Kirchhoff limit; `kappe_fe::element::dkmt`).
     #[arg(long, value_enum)]
     element: Option<ElementArg>,
 }
@@ -103,8 +112,16 @@ fn load(
     let mut model =
         parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))?;
     model.allow_mixed_orientation |= allow_mixed_orientation;
-    if let Some(e) = element {
-        model.element = e.into();
+    // The mesh file's own default is the fixtures' reference element (CST+DKT), so old files
+    // keep their meaning inside the library; the command's default is the shear-deformable
+    // element, which is at least as accurate on thin shells and right on thick ones (issue 17).
+    let names_element = serde_json::from_str::<Value>(&text)
+        .ok()
+        .is_some_and(|v| v.get("element").is_some());
+    match element {
+        Some(e) => model.element = e.into(),
+        None if !names_element => model.element = ElementKind::AndesDkmt,
+        None => {}
     }
     Ok(model)
 }
