@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::Iso;
-use crate::plan::{Context, Station, plan_station};
+use crate::plan::{Context, RungCache, Station, plan_station_cached};
 use crate::setup::BaseSearch;
 
 /// Candidate base poses of the grid, nearest the grid centre first (deterministic order).
@@ -100,10 +100,19 @@ pub(crate) fn search_stations(ctx: &Context, s: &BaseSearch) -> Result<Vec<Stati
         let mut last_err: Option<Box<PlanFailure>> = None;
         for &ci in order.iter().take(4) {
             let end = start + cover[ci];
-            // Plan the covered range; on failure shrink to the layers before the failing one.
+            // Plan the covered range; on failure shrink to the layers before the failing one
+            // (reusing this pose's vertices).
             let mut hi = end;
+            let mut cache: RungCache = None;
             while hi > start {
-                match plan_station(ctx, stations.len(), &cands[ci], start..hi, t0) {
+                match plan_station_cached(
+                    ctx,
+                    stations.len(),
+                    &cands[ci],
+                    start..hi,
+                    t0,
+                    &mut cache,
+                ) {
                     Ok(st) => {
                         let last = st.layers.last().and_then(|l| l.waypoints.last());
                         t0 = last.map_or(t0, |w| w.t) + ctx.opts.station_change_time;

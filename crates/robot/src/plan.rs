@@ -599,6 +599,23 @@ pub(crate) fn plan_station(
     range: std::ops::Range<usize>,
     t0: f64,
 ) -> Result<Station, Box<PlanFailure>> {
+    let mut cache = None;
+    plan_station_cached(ctx, station, world_from_base, range, t0, &mut cache)
+}
+
+/// The valid vertices of every rung of layers `start..` built for one base pose; a retry of the
+/// same pose over a shorter range (after a failure) reuses them.
+pub(crate) type RungCache = Option<(usize, Vec<(Vec<Vertex>, Rejections)>)>;
+
+/// [`plan_station`] reusing (or filling) `cache` for this base pose and `range.start`.
+pub(crate) fn plan_station_cached(
+    ctx: &Context,
+    station: usize,
+    world_from_base: &Iso,
+    range: std::ops::Range<usize>,
+    t0: f64,
+    cache: &mut RungCache,
+) -> Result<Station, Box<PlanFailure>> {
     let base_from_world = world_from_base.inverse();
     let fail = |layer: i64, index: usize, kind: FailureKind, detail: String| {
         Box::new(PlanFailure {
@@ -626,13 +643,22 @@ pub(crate) fn plan_station(
         .clone()
         .flat_map(|o| (0..ctx.layers[o].points.len()).map(move |k| (o, k)))
         .collect();
-    let built: Vec<(Vec<Vertex>, Rejections)> = rung_ids
-        .par_iter()
-        .map(|&(o, k)| {
-            let frame = ctx.target_frame(&ctx.layers[o], k);
-            ctx.vertices(&scene, &base_from_world, world_from_base, &frame, o)
-        })
-        .collect();
+    let usable =
+        matches!(cache, Some((start, b)) if *start == range.start && b.len() >= rung_ids.len());
+    if !usable {
+        let built: Vec<(Vec<Vertex>, Rejections)> = rung_ids
+            .par_iter()
+            .map(|&(o, k)| {
+                let frame = ctx.target_frame(&ctx.layers[o], k);
+                ctx.vertices(&scene, &base_from_world, world_from_base, &frame, o)
+            })
+            .collect();
+        *cache = Some((range.start, built));
+    }
+    let built: &[(Vec<Vertex>, Rejections)] = match cache {
+        Some((_, b)) => &b[..rung_ids.len()],
+        None => &[],
+    };
     let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
     // Allowed joint step per rung boundary. The layer change is a printed move like any other
