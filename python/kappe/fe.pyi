@@ -1,0 +1,3 @@
+from typing import Any, Dict, Mapping, Union
+
+def buckle(mesh: Union[str, Mapping[str, Any]], modes: int = ..., sturm_check: bool = ...) -> Dict[str, Any]: ...

@@ -1,0 +1,42 @@
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import kappe
+from conftest import FIXTURES
+
+
+def test_cem_fixture_equals_the_cli(tmp_path, kappe_bin):
+    src = FIXTURES / "cem" / "arch2d_crown.input.json"
+    topo = json.loads(src.read_text())
+    py = kappe.cem.solve(topo)
+    out = tmp_path / "eq.json"
+    subprocess.run([kappe_bin, "cem", "solve", str(src), "-o", str(out)], check=True)
+    assert py == json.loads(out.read_text())
+
+
+def test_cem_bad_topology_is_a_clear_error():
+    with pytest.raises(ValueError):
+        kappe.cem.solve({"nodes": "x"})
+    with pytest.raises(TypeError):
+        kappe.cem.solve(42)
+
+
+def test_fe_buckle_plate():
+    mesh = json.loads((FIXTURES / "fe" / "plate_ss_s3_n16.mesh.json").read_text())
+    r = kappe.fe.buckle(mesh, modes=2)
+    assert r["factors"].shape == (2,) and np.all(r["factors"] > 0)
+    with pytest.raises(ValueError):
+        kappe.fe.buckle(mesh, modes=0)
+
+
+def test_robot_ik_solutions_reach_the_pose():
+    pose = np.eye(4)
+    pose[:3, 3] = [0.6, 0.2, 0.4]
+    pose[:3, :3] = np.diag([1.0, -1.0, -1.0])
+    sols = kappe.robot.ik(pose)
+    assert sols.ndim == 2 and sols.shape[1] == 6 and len(sols) >= 1
+    with pytest.raises(ValueError):
+        kappe.robot.ik(np.eye(3))
