@@ -757,9 +757,13 @@
   }
   function updateMarkers() {
     if (!view.markers) return;
-    for (const { obj, ring } of view.markers.values()) ring.quaternion.copy(camera.quaternion);
+    for (const { ring } of view.markers.values()) ring.quaternion.copy(camera.quaternion);
     view.markerGroup.visible = $('show-markers').checked;
-    for (const { obj, place } of view.markers.values()) obj.visible = place.state === null || place.state === undefined || place.state <= now.state || true;
+    // A place in a layer not printed yet would float in the air: shown from its layer on.
+    for (const { obj, place } of view.markers.values()) {
+      const k = place.layer === null || place.layer === undefined ? -1 : layerIndex.get(place.layer);
+      obj.visible = k === undefined || k < layersShown();
+    }
   }
 
   // ---- camera: views, fit, floor, follow, triad, scale bar -----------------------------------
