@@ -61,11 +61,6 @@ fn scaled(copies: usize) -> ReportInput {
     // One state per layer: each layer's demo stresses scaled by how much is printed above it
     // (as the demo does), a layer age, and a mode shape bulging at the top layers.
     let n = input.layers.len();
-    let seg: Vec<usize> = input
-        .layers
-        .iter()
-        .map(|l| l.segment_stress.len())
-        .collect();
     input.states = (1..=n)
         .map(|printed| {
             let mut s = base.states[(printed - 1) % per_copy].clone();
