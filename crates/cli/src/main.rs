@@ -31,7 +31,7 @@ enum Command {
     Robot(cmd::robot::RobotCommand),
     /// Design a cap ceiling: form-find every print state, analyse, write outputs.
     Design(cmd::design::DesignArgs),
-    /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability.
+    /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability|ceiling.
     Init(cmd::init::InitArgs),
     /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
     Study(cmd::study::StudyCommand),

@@ -93,3 +93,12 @@ fn unknown_kind_is_a_usage_error() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("study"));
 }
+
+/// The ceiling example is a full-size room (a benchmark, not a test, to run); here it is
+/// written, documented verbatim and read by the ceiling reader.
+#[test]
+fn ceiling_example_is_documented() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "ceiling");
+    assert!(std::fs::read_to_string(tmp.path().join(file)).unwrap().contains("[[bay]]"));
+}

@@ -3,12 +3,13 @@
 //! examples, the docs and the readers cannot drift apart.
 
 /// The kinds of example file, with the text `kappe init --kind` writes.
-pub const KINDS: [(&str, &str); 5] = [
+pub const KINDS: [(&str, &str); 6] = [
     ("design", crate::spec::EXAMPLE_TOML),
     ("study", STUDY_TOML),
     ("prototypes", PROTOTYPES_TOML),
     ("optimize", OPTIMIZE_TOML),
     ("buildability", crate::buildability::EXAMPLE_TOML),
+    ("ceiling", crate::ceiling::EXAMPLE_TOML),
 ];
 
 /// A design study (`kappe study`): a 2 × 2 grid of short caps.
