@@ -1,14 +1,24 @@
 //! # kappe-report
 //!
-//! Plots and the self-contained, offline HTML report of a Kappe design (issue 8).
+//! Plots and the self-contained, offline HTML report of a Kappe design (issues 8, 14).
 //!
 //! The crate takes plain data, [`ReportInput`] (layers with their bead centre lines and stresses,
 //! bed joints, the print path, the print states, the constraint table and an optional robot
 //! animation), so it does not depend on the pipeline crates; the CLI fills it. Then
 //! [`render_html`] writes one HTML file that opens from `file://` without network access:
 //! three.js and OrbitControls (vendored, MIT, rebuilt by `web/build.sh`; `cargo build` never
-//! runs npm), a small hand-written viewer, the scene data as a JSON island and the plots as
-//! inline SVG (plotters; no fonts needed at generation time).
+//! runs npm), a small hand-written viewer, the scene data as a JSON island (long arrays as
+//! base64 typed arrays, see `island.rs`; [`read_island`] reads a page back) and the plots as
+//! inline SVG (plotters; no fonts needed at generation time). With a robot cell the page also
+//! carries the UR10e collision meshes (`assets/ur10e-meshes.json`, BSD-3-Clause, 75 kB).
+//!
+//! The viewer (`assets/viewer.js`) has one timeline: a moment of the print shows the beads
+//! printed by then (the partly printed layer included), the robot posed by the plan, the
+//! analysed state of the complete layers in the side panel and a cursor in every plot. Named
+//! views, fit, axis triad, scale bar, follow-the-nozzle; the state's buckling mode (scaled) and a
+//! marker at each constraint's worst place (a table row goes there); colour by any quantity of
+//! the island. Test hook: `window.kappeReport` (`seek`, `state`, `layers`, `robotTime`,
+//! `totalTime`, `nozzle`), used by `web/e2e/report.test.mjs`.
 //!
 //! [`render_study_html`] writes the design-study table of `kappe study` ([`StudyTable`]).
 //!
@@ -21,13 +31,16 @@
 //! - `states`: one per analysed state; `layers_printed` counts layers in print order;
 //!   `segment_stress` (optional) = that state's σ of the printed layers' segments, concatenated.
 //! - `print_path`: nozzle tip points, tool axis (−n), layer id per point.
-//! - `robot`: per time step the joint values and the world end points of each link capsule
-//!   (from FK), `link_radii` one per capsule; any number of capsules.
+//! - `robot`: per time step the joint values and the station (with a `cell` the viewer poses the
+//!   UR10e meshes by the URDF chain), or the world end points of link capsules (`link_radii`).
 //! - `constraints`: worst value per constraint; rows named `blf`, `sigma_min`, `sigma_max`,
 //!   `overhang` also draw their limits in the plots (units `kPa`/`Pa`/`MPa`, `mm`/`m`).
+//! - `timeline` (time of each path point), `cell` (stations, tool, mobile base, beams, floor),
+//!   `modes` (mode 1 on the bead nodes), `worst_places`, `quantities` (more colour quantities,
+//!   e.g. layer age and stiffness; each also gets a plot): `kappe::report_input` fills them.
 //!
-//! Write the string with the CLI's `write_file_atomic`; the page is about 0.8 MB plus the data
-//! (8 MB at the default design's size with per-state stresses, see `examples/size_table.rs`).
+//! Size: three.js is 0.77 MB; the default design's page is 2.4 MB; 1008 states (ten times the
+//! default) 20.3 MB (`cargo run --release -p kappe-report --example size_table`).
 //!
 //! ```
 //! use kappe_report::{demo_input, render_html};
