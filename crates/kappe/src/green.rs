@@ -383,6 +383,28 @@ impl CapGreen {
         let Ok(shell) = crate::shell::state_shell(state, material, row_stride) else {
             return Ok(None);
         };
+        let st = match kappe_fe::linear_static(&shell.model) {
+            Ok(st) => st,
+            // A mechanism is reported by the buckling check.
+            Err(FeError::Mechanism { .. }) => return Ok(None),
+            Err(e) => {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!("static analysis for the strength check failed: {e}"),
+                });
+            }
+        };
+        Ok(Some(self.stress_checks_on(&shell, &st, top)))
+    }
+
+    /// Strength and bed-joint sliding of the state with top print index `top` from the static
+    /// solution `st` of its shell model `shell` (the one its buckling solve computed).
+    pub fn stress_checks_on(
+        &self,
+        shell: &crate::shell::StateShell,
+        st: &kappe_fe::StaticResult,
+        top: usize,
+    ) -> StressWorst {
         let elements: Vec<ElementLayers> = shell
             .element_layers
             .iter()
@@ -396,24 +418,7 @@ impl CapGreen {
                 }
             })
             .collect();
-        let st = match kappe_fe::linear_static(&shell.model) {
-            Ok(st) => st,
-            // A mechanism is reported by the buckling check.
-            Err(FeError::Mechanism { .. }) => return Ok(None),
-            Err(e) => {
-                return Err(DesignError::State {
-                    state: top,
-                    message: format!("static analysis for the strength check failed: {e}"),
-                });
-            }
-        };
         let ages = self.schedule.ages(top + 1);
-        Ok(Some(stress_checks(
-            &st,
-            &elements,
-            &ages,
-            &self.time,
-            &GreenOptions::default(),
-        )))
+        stress_checks(st, &elements, &ages, &self.time, &GreenOptions::default())
     }
 }

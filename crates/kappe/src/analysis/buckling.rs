@@ -123,6 +123,18 @@ pub fn shell_buckling_mode(
     state: usize,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode), DesignError> {
+    shell_buckling_full(shell, state, options).map(|(b, mode, _)| (b, mode))
+}
+
+/// [`shell_buckling_mode`] and the linear static solution the buckling solve started from (None
+/// for a mechanism): the green-state strength checks read its membrane stresses, so they cost
+/// no second factorization (issue 11).
+#[allow(clippy::type_complexity)]
+pub fn shell_buckling_full(
+    shell: &StateShell,
+    state: usize,
+    options: &AnalysisOptions,
+) -> Result<(StateBuckling, NetworkMode, Option<kappe_fe::StaticResult>), DesignError> {
     let fe_opts = kappe_fe::BucklingOptions {
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
@@ -134,6 +146,7 @@ pub fn shell_buckling_mode(
     let n = shell.model.nodes.len();
     match kappe_fe::buckling(&shell.model, &fe_opts) {
         Ok(r) => {
+            let static_result = Some(r.static_result.clone());
             let location = r.modes.first().and_then(|m| {
                 let (i, _) = m
                     .iter()
@@ -165,6 +178,7 @@ pub fn shell_buckling_mode(
                     shell_nodes: n,
                 },
                 mode,
+                static_result,
             ))
         }
         Err(kappe_fe::FeError::Mechanism { free_dofs }) => {
@@ -193,6 +207,7 @@ pub fn shell_buckling_mode(
                     shell_nodes: n,
                 },
                 Vec::new(),
+                None,
             ))
         }
         Err(e) => Err(DesignError::State {

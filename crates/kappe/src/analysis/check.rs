@@ -8,7 +8,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, NetworkMode, StateBuckling, state_buckling_mode, state_material,
+    BucklingStatus, NetworkMode, StateBuckling, shell_buckling_full, state_buckling_mode,
+    state_material,
 };
 use super::options::AnalysisOptions;
 use super::stress::{ElementStress, STRESS_REL_TOL, element_stresses};
@@ -266,10 +267,24 @@ pub(crate) fn analyze_until(
             let t0 = Instant::now();
             let state = build_state(&cap.sections, &cap.frame, phi, top)?;
             let mat = state_material(cap, options, top);
-            let (b, mode) = state_buckling_mode(&state, &mat, options)?;
-            let g = match &green {
-                Some(g) => g.stress_checks(&state, &mat, options.row_stride, top)?,
-                None => None,
+            // With a strength model the buckling solve's own static solution gives the
+            // membrane stresses (one factorization per state, not two).
+            let shell = match &green {
+                Some(g) if g.time.strength.is_some() => {
+                    crate::shell::state_shell(&state, &mat, options.row_stride).ok()
+                }
+                _ => None,
+            };
+            let (b, mode, g) = match (&green, shell) {
+                (Some(gr), Some(shell)) => {
+                    let (b, mode, st) = shell_buckling_full(&shell, state.index, options)?;
+                    let g = st.map(|st| gr.stress_checks_on(&shell, &st, top));
+                    (b, mode, g)
+                }
+                _ => {
+                    let (b, mode) = state_buckling_mode(&state, &mat, options)?;
+                    (b, mode, None)
+                }
             };
             on_state(n_fe);
             Ok((top, b, mode, g, t0.elapsed().as_secs_f64()))
