@@ -345,7 +345,9 @@ fn waits_age_the_layers_below() {
 
 /// The analysis of a design as comparable data: every state's BLF and stresses, the constraint
 /// report (timings left out: wall clock).
-fn analysis_fingerprint(design_toml: &str) -> (Vec<(Option<f64>, f64, f64)>, String) {
+type Fingerprint = (Vec<(Option<f64>, f64, f64)>, String);
+
+fn analysis_fingerprint(design_toml: &str) -> Fingerprint {
     let design = kappe::Design::from_toml_str(design_toml).expect("design");
     let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
     let mut options = design.analysis.clone();
@@ -384,9 +386,7 @@ fn old_ageing_table_is_the_linear_time_model() {
     let new = analysis_fingerprint(&format!(
         "{base}[material.time]\nmodel = \"linear\"\nyoungs_modulus = 5.0e6\nyoungs_modulus_rate = 2.0e4\n"
     ));
-    let blfs = |f: &(Vec<(Option<f64>, f64, f64)>, String)| -> Vec<f64> {
-        f.0.iter().filter_map(|s| s.0).collect()
-    };
+    let blfs = |f: &Fingerprint| -> Vec<f64> { f.0.iter().filter_map(|s| s.0).collect() };
     // Same layer ages (path length / speed, summed the same way) and the same E(t): equal to
     // the solver's tolerance (1e-8 relative Lanczos residual; 1e-7 leaves room for the
     // different order in which the two paths fill the per-layer moduli).
