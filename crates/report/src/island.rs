@@ -523,9 +523,11 @@ pub fn read_island(json: &str) -> Result<ReportInput, ReportError> {
             .collect(),
     };
     let point_time = d_f32(&path["time"], "path.time")?;
+    // The end is written with 7 digits, the point times as f32: keep the end after the last.
     let total_time = from("total_time")?
         .as_f64()
-        .ok_or_else(|| bad("total_time"))?;
+        .ok_or_else(|| bad("total_time"))?
+        .max(point_time.last().copied().unwrap_or(0.0));
     // Per-state layer stress from the chunk pool of the first quantity.
     let q = from("quantities")?
         .get(0)
