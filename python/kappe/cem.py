@@ -8,7 +8,7 @@ from typing import Any, Dict, Mapping, Union
 
 from . import _kappe
 
-__all__ = ["solve", "optimize"]
+__all__ = ["solve", "optimize", "Topology"]
 
 
 def _text(topology: Union[str, Mapping[str, Any]]) -> str:
@@ -29,3 +29,23 @@ def optimize(topology: Union[str, Mapping[str, Any]]) -> Dict[str, Any]:
     """Constrained form-finding of a topology with an ``optimization`` block:
     ``{"converged", "status", "objective", "equilibrium"}``."""
     return json.loads(_kappe.cem_optimize(_text(topology)))
+
+
+class Topology:
+    """A topology parsed once, to solve many times (no JSON round trip per solve):
+    ``Topology(dict).solve()`` returns NumPy arrays ``xyz`` (n×3), ``trail_forces``,
+    ``deviation_forces`` and ``reactions`` (n×3)."""
+
+    def __init__(self, topology: Union[str, Mapping[str, Any]]) -> None:
+        self._native = _kappe.Topology(_text(topology))
+
+    def solve(self) -> Dict[str, Any]:
+        import numpy as np
+
+        xyz, trail, deviation, reactions = self._native.solve()
+        return {
+            "xyz": np.asarray(xyz, dtype=float).reshape(-1, 3),
+            "trail_forces": np.asarray(trail, dtype=float),
+            "deviation_forces": np.asarray(deviation, dtype=float),
+            "reactions": np.asarray(reactions, dtype=float).reshape(-1, 3),
+        }

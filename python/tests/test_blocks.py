@@ -40,3 +40,12 @@ def test_robot_ik_solutions_reach_the_pose():
     assert sols.ndim == 2 and sols.shape[1] == 6 and len(sols) >= 1
     with pytest.raises(ValueError):
         kappe.robot.ik(np.eye(3))
+
+
+def test_prepared_topology_equals_the_json_solve():
+    topo = json.loads((FIXTURES / "cem" / "arch2d_crown.input.json").read_text())
+    full = kappe.cem.solve(topo)
+    fast = kappe.cem.Topology(topo).solve()
+    xyz = np.asarray([n["xyz"] for n in full["nodes"]], dtype=float)
+    # Same solve, same numbers: the JSON writer prints shortest round-trip floats.
+    assert np.array_equal(fast["xyz"], xyz)

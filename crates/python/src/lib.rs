@@ -388,6 +388,46 @@ fn cem_solve(py: Python<'_>, topology_json: &str, force_polygons: bool) -> PyRes
     Ok(text)
 }
 
+/// A topology parsed once (`kappe.cem.Topology`), to solve many times without the JSON round
+/// trip of [`cem_solve`]: the call then costs the solve plus copying the results.
+#[pyclass(frozen, module = "kappe._kappe")]
+struct Topology {
+    file: kappe_cem::json::TopologyFile,
+}
+
+#[pymethods]
+impl Topology {
+    /// Parse and check a topology (JSON text in the `kappe.cem.topology` format).
+    #[new]
+    fn new(topology_json: &str) -> PyResult<Self> {
+        let file = kappe_cem::json::read_topology(topology_json)
+            .map_err(|e| PyValueError::new_err(format!("invalid topology: {e}")))?;
+        Ok(Topology { file })
+    }
+
+    /// Solve; returns `(xyz, trail_forces, deviation_forces, reactions)`: node coordinates
+    /// (n×3, in node order), the signed edge forces, and the support reactions (n×3, zero off
+    /// supports), as flat lists for NumPy.
+    fn solve(&self, py: Python<'_>) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
+        let eq = py
+            .detach(|| kappe_cem::solve(&self.file.topology, &self.file.solver))
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot solve: {e}")))?;
+        let xyz = eq
+            .nodes
+            .iter()
+            .flat_map(|n| [n.xyz.x, n.xyz.y, n.xyz.z])
+            .collect();
+        let reactions = eq
+            .nodes
+            .iter()
+            .flat_map(|n| [n.reaction.x, n.reaction.y, n.reaction.z])
+            .collect();
+        let trail = eq.trail_edges.iter().map(|e| e.force).collect();
+        let deviation = eq.deviation_edges.iter().map(|e| e.force).collect();
+        Ok((xyz, trail, deviation, reactions))
+    }
+}
+
 /// `kappe cem optimize`: a topology with an `optimization` block; returns JSON of
 /// `{converged, status, objective, equilibrium}`.
 #[pyfunction]
@@ -469,6 +509,7 @@ fn _kappe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(study_collect, m)?)?;
     m.add_function(wrap_pyfunction!(cem_solve, m)?)?;
     m.add_function(wrap_pyfunction!(cem_optimize, m)?)?;
+    m.add_class::<Topology>()?;
     m.add_function(wrap_pyfunction!(fe_buckle, m)?)?;
     m.add_function(wrap_pyfunction!(robot_ik, m)?)?;
     Ok(())
