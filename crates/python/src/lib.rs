@@ -388,6 +388,9 @@ fn cem_solve(py: Python<'_>, topology_json: &str, force_polygons: bool) -> PyRes
     Ok(text)
 }
 
+/// `(xyz, trail_forces, deviation_forces, reactions)` of [`Topology::solve`], flat.
+type SolvedArrays = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
+
 /// A topology parsed once (`kappe.cem.Topology`), to solve many times without the JSON round
 /// trip of [`cem_solve`]: the call then costs the solve plus copying the results.
 #[pyclass(frozen, module = "kappe._kappe")]
@@ -408,7 +411,7 @@ impl Topology {
     /// Solve; returns `(xyz, trail_forces, deviation_forces, reactions)`: node coordinates
     /// (n×3, in node order), the signed edge forces, and the support reactions (n×3, zero off
     /// supports), as flat lists for NumPy.
-    fn solve(&self, py: Python<'_>) -> PyResult<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
+    fn solve(&self, py: Python<'_>) -> PyResult<SolvedArrays> {
         let eq = py
             .detach(|| kappe_cem::solve(&self.file.topology, &self.file.solver))
             .map_err(|e| PyRuntimeError::new_err(format!("cannot solve: {e}")))?;
