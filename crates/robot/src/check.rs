@@ -96,6 +96,43 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 continue;
             }
         };
+        // The approach from the safe pose behind the station's first target and the retract
+        // after its last (joint-interpolated, like the layer changes; the pose itself too).
+        let ends = [
+            st.layers
+                .first()
+                .and_then(|l| l.waypoints.first())
+                .map(|w| (w.q, order, "approach")),
+            st.layers
+                .last()
+                .and_then(|l| l.waypoints.last())
+                .map(|w| (w.q, order + st.layers.len(), "retract")),
+        ];
+        for (q, tag, what) in ends.into_iter().flatten() {
+            match crate::program::approach_config(
+                &q,
+                &flange_from_tcp,
+                opts.program.approach_distance,
+            ) {
+                Ok(qa) => {
+                    let posed = ctx.self_model.pose(&qa, &Iso::IDENTITY);
+                    let (ds, _) = ctx.self_model.min_self_distance_posed(&posed);
+                    let env = ctx.env_model.pose(&qa, &world_from_base);
+                    let c = scene.clearance(env.as_slice(), tag, CLEARANCE_CUTOFF);
+                    if ds < opts.self_clearance || (c.distance <= 1e-12 && c.object.is_some()) {
+                        problems.push(format!(
+                            "station {si}: the {what} pose collides ({:?})",
+                            c.object.unwrap_or_default()
+                        ));
+                    } else if let Some(msg) =
+                        transition_collision(&ctx, &scene, &world_from_base, &qa, &q, tag)
+                    {
+                        problems.push(format!("station {si}: {what}: {msg}"));
+                    }
+                }
+                Err(e) => problems.push(format!("station {si}: {what}: {e}")),
+            }
+        }
         let mut prev_end: Option<[f64; 6]> = None;
         for l in &st.layers {
             if let (Some(a), Some(w0)) = (prev_end, l.waypoints.first())

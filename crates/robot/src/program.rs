@@ -122,7 +122,7 @@ fn num(x: f64) -> String {
 
 /// The safe approach configuration: the first target backed off `dist` along the tool axis,
 /// the IK solution nearest `q` (same branch), unwrapped next to `q`.
-fn approach_config(q: &Joints, tool: &Iso, dist: f64) -> Result<Joints, RobotError> {
+pub(crate) fn approach_config(q: &Joints, tool: &Iso, dist: f64) -> Result<Joints, RobotError> {
     let tcp = UR10E.fk(q).mul(tool);
     let back = tcp.mul(&Iso::translation(0.0, 0.0, -dist));
     let flange = back.mul(&tool.inverse());

@@ -409,6 +409,22 @@ fn bad_program_input_is_named() {
     assert!(e.contains("> 1"), "{e}");
 }
 
+/// The check covers the approach from the safe pose: one out of reach is named.
+#[test]
+fn an_unreachable_approach_pose_fails_the_check() {
+    let (layers, setup, opts) = small();
+    let mut plan = plan_print(&layers[..2], &setup, &opts).unwrap();
+    assert!(check_plan(&plan).problems.is_empty());
+    plan.options.program.approach_distance = 3.0; // beyond the 1.3 m reach
+    let problems = check_plan(&plan).problems;
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.contains("approach") && p.contains("no joint configuration")),
+        "{problems:?}"
+    );
+}
+
 #[test]
 fn lint_rejects_what_the_controller_would() {
     let ok = "def a():\n  movej([0, -1.5, 1.0, 0, 1.2, 0], a=1.0, v=0.5)\n  sleep(0.5)\nend\na()\n";
