@@ -22,6 +22,14 @@
 //!
 //! Bays sit side by side across x, a beam of `robot.beams.width` between neighbours; the
 //! summary gives every bay's centre line.
+//!
+//! **A large ceiling on a cluster.** Bays are independent designs: [`CeilingDesign::bay_designs`]
+//! gives one [`Design`] per bay (one half for `both_walls`), each a complete single-cap design
+//! file (`Design::to_toml_string`). Spread them with the study path, one bay per task: write the
+//! bays as a `kappe study` list (or call `kappe.study` / `kappe.design` from Python and map the bay
+//! designs over a Dask cluster, one design per task), then gather the per-bay `summary.json`s; the
+//! ceiling summary is the per-bay rows of [`BayOutcome::summary`] summed (mass, volume, times).
+//! Within one bay the states already run in parallel on the task's cores.
 
 use std::ops::ControlFlow;
 

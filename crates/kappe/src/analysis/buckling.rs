@@ -89,6 +89,16 @@ pub fn state_buckling_mode(
     material: &ShellMaterial,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode), DesignError> {
+    // A graded mesh (issue 15, `crate::window`) analyses the state reduced to its kept rows; the
+    // mode is mapped back to the state's own network nodes.
+    let graded;
+    let (state, node_map) = match &options.grading {
+        Some(g) => {
+            graded = crate::window::graded_state_map(state, g);
+            (&graded.0, Some(&graded.1))
+        }
+        None => (state, None),
+    };
     let shell = match state_shell(state, material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
@@ -104,7 +114,13 @@ pub fn state_buckling_mode(
             ));
         }
     };
-    shell_buckling_mode(&shell, state.index, options)
+    let (b, mut mode) = shell_buckling_mode(&shell, state.index, options)?;
+    if let Some(map) = node_map {
+        for (k, _) in &mut mode {
+            *k = map.get(*k).copied().unwrap_or(*k);
+        }
+    }
+    Ok((b, mode))
 }
 
 /// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in

@@ -168,6 +168,11 @@ pub struct AnalysisOptions {
     /// Kirchhoff element used before issue 17), `"andes_dkt"`, `"cst_dkmt"`.
     #[serde(default = "default_element")]
     pub element: ElementKind,
+    /// A graded shell mesh along the print direction (`crate::window`): every layer a row near
+    /// the top, rows thinning out with depth, so the cost per state stops growing with the bay
+    /// length (issue 15). `None` (default): every layer is a row.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grading: Option<crate::window::Grading>,
 }
 
 impl Default for AnalysisOptions {
@@ -180,6 +185,7 @@ impl Default for AnalysisOptions {
             buckling: true,
             sturm_check: false,
             element: default_element(),
+            grading: None,
         }
     }
 }
