@@ -189,7 +189,7 @@ fn evaluate_until(
         let ticker = Ticker::new(on_progress, stop, Stage::Robot);
         ticker.report(0, 1);
         check(stop)?;
-        let plan = crate::robot_plan::plan_robot(&cap);
+        let plan = plan_with_schedule_waits(&cap)?;
         ticker.report(1, 1);
         Some(plan)
     } else {
@@ -239,8 +239,27 @@ impl Outcome {
                 serde_json::json!(programs.err()),
             );
             obj.insert("ok".into(), serde_json::json!(self.ok));
+            if let Ok(schedule) = self.schedule() {
+                obj.insert("schedule".into(), serde_json::json!(schedule));
+            }
         }
         summary
+    }
+
+    /// The print schedule (issue 11): every layer's start, end, wait and station change, from
+    /// the timed robot plan when there is one (the clock of `trajectory.csv` and the programs),
+    /// else from path length / print speed and the `[schedule]` waits. `schedule.csv` and the
+    /// `schedule` block of `summary.json` are this.
+    ///
+    /// # Errors
+    /// A `[schedule]` that does not fit the print ([`DesignError::Invalid`]).
+    pub fn schedule(&self) -> Result<crate::schedule::Schedule, DesignError> {
+        match &self.robot {
+            Some(Ok(plan)) => {
+                crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan))
+            }
+            _ => crate::schedule::cap_schedule(&self.cap),
+        }
     }
 
     /// The print time, s, computed once for the table, the robot line, the summary and the
@@ -318,4 +337,26 @@ fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
         "layer_times": kappe_robot::layer_times(plan),
         "geometry": plan.meshes,
     })
+}
+
+/// Plan the robot with the design's `[schedule]` waits (so the printed schedule is the checked
+/// one: the waits become pauses in the programs), or with the planner's own minimum layer time
+/// when the design sets none.
+fn plan_with_schedule_waits(
+    cap: &Cap,
+) -> Result<Result<kappe_robot::Plan, kappe_robot::RobotError>, DesignError> {
+    let waits = cap.design.schedule.waits(cap.sections.layers.len())?;
+    if waits.iter().all(|w| *w == 0.0) {
+        return Ok(crate::robot_plan::plan_robot(cap));
+    }
+    let layers = crate::robot_plan::print_layers(&cap.path);
+    let given: Vec<kappe_robot::LayerWait> = layers
+        .iter()
+        .zip(&waits)
+        .map(|(l, w)| kappe_robot::LayerWait {
+            layer: l.layer,
+            wait: *w,
+        })
+        .collect();
+    Ok(crate::robot_plan::plan_robot_with_waits(cap, Some(&given)))
 }

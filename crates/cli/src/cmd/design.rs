@@ -132,6 +132,10 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         std::fs::write(dir.join("cap.obj"), cap.mesh.to_obj(&cap.design.name))?;
         std::fs::write(dir.join("cap.glb"), cap.mesh.to_glb())?;
         std::fs::write(dir.join("report.html"), &report)?;
+        // The layer times the structural check and the robot share (issue 11).
+        if let Ok(schedule) = eval.schedule() {
+            std::fs::write(dir.join("schedule.csv"), schedule.to_csv())?;
+        }
         if !trajectory.is_empty() {
             std::fs::write(dir.join("trajectory.csv"), &trajectory)?;
             std::fs::write(dir.join("plan.json"), &plan_json)?;
