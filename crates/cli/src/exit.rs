@@ -88,6 +88,9 @@ fn status_of_cause(cause: &(dyn std::error::Error + 'static)) -> Option<u8> {
             _ => FAILS,
         });
     }
+    if cause.is::<kappe::study::StudyError>() {
+        return Some(USAGE);
+    }
     if cause.is::<kappe_report::ReportError>() {
         return Some(INTERNAL);
     }

@@ -49,6 +49,9 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read the design file {}", path.display()))?;
+            if kappe::ceiling::is_ceiling_toml(&text) {
+                return run_ceiling(&args, &text, path);
+            }
             kappe::Design::from_toml_str(&text)
                 .with_context(|| format!("invalid design file {}", path.display()))?
         }
@@ -311,4 +314,108 @@ fn print_table(cap: &kappe::Cap, print_time: f64, out: &std::path::Path) {
         "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb, report.html}}",
         out.display()
     );
+}
+
+/// A ceiling file (`[ceiling]` + `[[bay]]`, issue 15): every bay designed, analysed and planned
+/// (`kappe::ceiling::run_ceiling`); writes `ceiling.json` (the room summary), `index.html` (the
+/// room page) and per bay `bay_N/{summary.json, report.html, path.csv}` plus, when the bay passes
+/// (or `--allow-fail`), its robot programs (`bay_N/program_partNN.script`, `programs.json`,
+/// `trajectory.csv`, `plan.json`; the mirrored second half of a `both_walls` bay under
+/// `bay_N/mirror/`).
+fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<ExitCode> {
+    let ceiling = kappe::ceiling::CeilingDesign::from_toml_str(text)
+        .with_context(|| format!("invalid ceiling file {}", path.display()))?;
+    let mut options = kappe::Options::of(&kappe::Design::default());
+    if let Some(analysis) = options.analysis.as_mut() {
+        if let Some(states) = &args.states {
+            analysis.states = states
+                .parse()
+                .map_err(|e| Usage(format!("--states: {e}")))?;
+        }
+        if args.no_buckling {
+            analysis.buckling = false;
+        }
+    }
+    options.robot = !args.no_robot;
+    options.allow_fail = args.allow_fail;
+    let prepared = prepare_dir(&args.out, args.force, "design (ceiling)")?;
+    let silent = args.quiet || args.json;
+    let spinner = if silent {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new_spinner()
+    };
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let on_progress = |bay: usize, p: kappe::Progress| {
+        spinner.set_message(format!(
+            "bay {}: {:?} {}/{}",
+            bay + 1,
+            p.stage,
+            p.done,
+            p.total
+        ));
+        std::ops::ControlFlow::Continue(())
+    };
+    let out = kappe::ceiling::run_ceiling(&ceiling, &options, &on_progress)?;
+    spinner.finish_and_clear();
+    let dir = prepared.path();
+    let summary = out.summary();
+    std::fs::write(dir.join("ceiling.json"), serde_json::to_vec_pretty(&summary)?)?;
+    std::fs::write(dir.join("index.html"), out.index_html())?;
+    for (i, bay) in out.bays.iter().enumerate() {
+        let bay_dir = dir.join(format!("bay_{}", i + 1));
+        std::fs::create_dir_all(&bay_dir)?;
+        let eval = &bay.outcome;
+        std::fs::write(
+            bay_dir.join("summary.json"),
+            serde_json::to_vec_pretty(&eval.summary())?,
+        )?;
+        std::fs::write(bay_dir.join("report.html"), eval.report_html()?)?;
+        std::fs::write(bay_dir.join("path.csv"), eval.cap.path.to_csv())?;
+        if eval.ok || args.allow_fail {
+            if let Some(Ok(plan)) = &eval.robot {
+                let files = crate::cmd::robot::linted_programs(plan, "program_part")?;
+                crate::cmd::robot::write_plan_outputs(&bay_dir, plan, &files)?;
+            }
+            if let Some(Ok(plan)) = &bay.mirror_plan {
+                let mirror = bay_dir.join("mirror");
+                std::fs::create_dir_all(&mirror)?;
+                let files = crate::cmd::robot::linted_programs(plan, "program_part")?;
+                crate::cmd::robot::write_plan_outputs(&mirror, plan, &files)?;
+            }
+        }
+    }
+    if let Some(notice) = prepared.commit()? {
+        eprintln!("note: {notice}");
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else if !args.quiet {
+        println!(
+            "Kappe ceiling: {} bay(s); wrote {}/{{ceiling.json, index.html, bay_N/}}",
+            out.bays.len(),
+            args.out.display()
+        );
+        for (i, bay) in out.bays.iter().enumerate() {
+            println!(
+                "  bay {}: span {:.3} m, {} half/halves, {}",
+                i + 1,
+                bay.design.cap.span,
+                bay.halves,
+                if bay.outcome.ok { "passes" } else { "FAILS" }
+            );
+        }
+    }
+    if !out.ok {
+        let level = if args.allow_fail { "warning" } else { "error" };
+        for (i, b) in out.bays.iter().enumerate() {
+            if !b.outcome.ok {
+                eprintln!("{level}: bay {} fails its checks (see bay_{}/report.html)", i + 1, i + 1);
+            }
+        }
+        if !args.allow_fail {
+            return Ok(crate::exit::fails());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }
