@@ -342,17 +342,6 @@ impl Drop for PreparedDir {
     }
 }
 
-/// Prepare `dir`, let `fill` write into the staging directory, then commit. For commands whose
-/// computing happens inside `fill`; commands that compute first call [`prepare_dir`] early.
-pub fn write_dir_atomic(dir: &Path, fill: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let prepared = prepare_dir(dir, false, "kappe")?;
-    fill(prepared.path())?;
-    if let Some(notice) = prepared.commit()? {
-        eprintln!("note: {notice}");
-    }
-    Ok(())
-}
-
 /// Decide what may be done with an existing directory at `target`.
 fn classify_existing(target: &Path, force: bool) -> Result<Previous> {
     let present = list_files(target).with_context(|| format!("cannot read {}", target.display()))?;

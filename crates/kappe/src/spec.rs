@@ -454,7 +454,18 @@ impl Design {
 
 /// Deserialize TOML text into `T`, reporting the dotted path of a bad entry and, for an unknown
 /// field, the closest allowed name. Every TOML file Kappe reads goes through here.
+///
+/// A file that sets nothing (empty, or only comments) is an error rather than silently meaning
+/// "all defaults": a user who runs an empty file almost certainly meant another file.
 pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, DesignError> {
+    if toml::from_str::<toml::Table>(text).is_ok_and(|t| t.is_empty()) {
+        return Err(DesignError::Parse {
+            path: String::new(),
+            message: "the file is empty (it sets no table and no field); `kappe init` writes a \
+                      commented example, and `kappe design` without a file runs the default design"
+                .into(),
+        });
+    }
     let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
         path: String::new(),
         message: e.to_string().trim().to_string(),
