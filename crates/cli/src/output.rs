@@ -121,9 +121,7 @@ pub fn check_user_file(path: &Path, force: bool) -> Result<()> {
             let _ = std::fs::remove_file(&probe);
             Ok(())
         }
-        Err(err) => {
-            Err(IoFailure(format!("cannot write into {}: {err}", dir.display())).into())
-        }
+        Err(err) => Err(IoFailure(format!("cannot write into {}: {err}", dir.display())).into()),
     }
 }
 
@@ -206,7 +204,10 @@ pub fn prepare_dir(dir: &Path, force: bool, command: &str) -> Result<PreparedDir
 
     // Create the missing parents (remembered, to be removed again if the run fails), then the
     // staging directory: this is the early proof that the location can be written.
-    let parent = target.parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from("/"));
+    let parent = target
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("/"));
     let mut created_parents = Vec::new();
     let mut missing = Vec::new();
     let mut p = parent.as_path();
@@ -239,10 +240,7 @@ pub fn prepare_dir(dir: &Path, force: bool, command: &str) -> Result<PreparedDir
         COUNTER.fetch_add(1, Ordering::Relaxed)
     ));
     let made = std::fs::create_dir(&staging).and_then(|()| {
-        std::fs::write(
-            staging.join(STAGING_MARKER),
-            std::process::id().to_string(),
-        )
+        std::fs::write(staging.join(STAGING_MARKER), std::process::id().to_string())
     });
     if let Err(err) = made {
         let _ = std::fs::remove_dir_all(&staging);
@@ -344,7 +342,8 @@ impl Drop for PreparedDir {
 
 /// Decide what may be done with an existing directory at `target`.
 fn classify_existing(target: &Path, force: bool) -> Result<Previous> {
-    let present = list_files(target).with_context(|| format!("cannot read {}", target.display()))?;
+    let present =
+        list_files(target).with_context(|| format!("cannot read {}", target.display()))?;
     if present.is_empty() && list_entries_empty(target) {
         return Ok(Previous::EmptyDir);
     }
@@ -407,11 +406,9 @@ fn in_nested_output(root: &Path, rel: &str) -> bool {
             .ok()
             .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
             .and_then(|v| {
-                v.get("files")?
-                    .as_array()
-                    .map(|a| {
-                        inner == MANIFEST || a.iter().any(|f| f.as_str() == Some(inner.as_str()))
-                    })
+                v.get("files")?.as_array().map(|a| {
+                    inner == MANIFEST || a.iter().any(|f| f.as_str() == Some(inner.as_str()))
+                })
             })
             .unwrap_or(false)
     })
@@ -523,7 +520,10 @@ mod tests {
 
     #[test]
     fn normalize_resolves_dots() {
-        assert_eq!(normalize(Path::new("/a/b/../c/./d")), PathBuf::from("/a/c/d"));
+        assert_eq!(
+            normalize(Path::new("/a/b/../c/./d")),
+            PathBuf::from("/a/c/d")
+        );
         assert_eq!(normalize(Path::new("/a/..")), PathBuf::from("/"));
     }
 }

@@ -26,11 +26,23 @@ fn design_runs_a_three_bay_ceiling() {
     std::fs::write(tmp.path().join("room.toml"), SMALL).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_kappe"))
         .current_dir(tmp.path())
-        .args(["design", "room.toml", "--out", "room", "--quiet", "--states", "every:4"])
+        .args([
+            "design",
+            "room.toml",
+            "--out",
+            "room",
+            "--quiet",
+            "--states",
+            "every:4",
+        ])
         .output()
         .unwrap();
     let code = o.status.code().unwrap_or(-1);
-    assert!(code == 0 || code == 1, "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        code == 0 || code == 1,
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let out = tmp.path().join("room");
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("ceiling.json")).unwrap()).unwrap();
@@ -55,5 +67,8 @@ fn design_runs_a_three_bay_ceiling() {
             assert!(bay.join("mirror/programs.json").is_file(), "bay {n} mirror");
         }
     }
-    assert_eq!(code == 0, bays.iter().all(|b| b["ok"] == serde_json::json!(true)));
+    assert_eq!(
+        code == 0,
+        bays.iter().all(|b| b["ok"] == serde_json::json!(true))
+    );
 }

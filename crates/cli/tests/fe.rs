@@ -159,13 +159,21 @@ fn buckle_defaults_to_the_shear_deformable_element() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("vault.json");
     let mesh = fixture("vault_s3_20x12.mesh.json");
-    let o = kappe(&["fe", "buckle", mesh.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let o = kappe(&[
+        "fe",
+        "buckle",
+        mesh.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let r = read_json(&out);
     assert_eq!(r["solver"]["element_kind"].as_str(), Some("andes_dkmt"));
     let got = r["factors"][0].as_f64().unwrap();
     let refs = read_json(&fixture("facet_ref_results.json"));
-    let cst = refs["results"]["vault_s3_20x12"]["lambda"][0].as_f64().unwrap();
+    let cst = refs["results"]["vault_s3_20x12"]["lambda"][0]
+        .as_f64()
+        .unwrap();
     assert!(got < cst, "{got} vs CST+DKT {cst}");
     assert!((got / 0.068970 - 1.0).abs() < 0.01, "{got}");
 }

@@ -46,7 +46,16 @@ fn design_example_runs() {
     // is read as it is.
     let o = kappe(
         tmp.path(),
-        &["design", &file, "--out", "o", "--quiet", "--no-robot", "--states", "every:8"],
+        &[
+            "design",
+            &file,
+            "--out",
+            "o",
+            "--quiet",
+            "--no-robot",
+            "--states",
+            "every:8",
+        ],
     );
     ran(&o, &tmp.path().join("o"), "summary.json");
     assert_eq!(o.status.code(), Some(0), "the default design passes");
@@ -56,10 +65,17 @@ fn design_example_runs() {
 fn study_example_runs() {
     let tmp = tempfile::tempdir().unwrap();
     let file = init(tmp.path(), "study");
-    let o = kappe(tmp.path(), &["study", &file, "--out", "s", "--quiet", "--no-robot"]);
+    let o = kappe(
+        tmp.path(),
+        &["study", &file, "--out", "s", "--quiet", "--no-robot"],
+    );
     ran(&o, &tmp.path().join("s"), "study.csv");
     let csv = std::fs::read_to_string(tmp.path().join("s/study.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 1 + 4, "a 2 × 2 grid: header and four rows");
+    assert_eq!(
+        csv.lines().count(),
+        1 + 4,
+        "a 2 × 2 grid: header and four rows"
+    );
 }
 
 #[test]
@@ -100,5 +116,9 @@ fn unknown_kind_is_a_usage_error() {
 fn ceiling_example_is_documented() {
     let tmp = tempfile::tempdir().unwrap();
     let file = init(tmp.path(), "ceiling");
-    assert!(std::fs::read_to_string(tmp.path().join(file)).unwrap().contains("[[bay]]"));
+    assert!(
+        std::fs::read_to_string(tmp.path().join(file))
+            .unwrap()
+            .contains("[[bay]]")
+    );
 }

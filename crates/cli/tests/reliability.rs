@@ -100,13 +100,20 @@ fn unrelated_non_empty_directory_is_refused_then_moved_aside_with_force() {
     let before = snapshot(tmp.path());
     let o = design(tmp.path(), &file, "mine", &[]);
     assert_eq!(code(&o), 2, "{}", stderr(&o));
-    assert!(stderr(&o).contains("thesis.tex"), "names the foreign file: {}", stderr(&o));
+    assert!(
+        stderr(&o).contains("thesis.tex"),
+        "names the foreign file: {}",
+        stderr(&o)
+    );
     assert_eq!(snapshot(tmp.path()), before);
 
     let o = design(tmp.path(), &file, "mine", &["--force"]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let aside = tmp.path().join("mine.old-1");
-    assert_eq!(std::fs::read(aside.join("thesis.tex")).unwrap(), b"years of work");
+    assert_eq!(
+        std::fs::read(aside.join("thesis.tex")).unwrap(),
+        b"years of work"
+    );
     assert!(target.join("summary.json").is_file());
 }
 
@@ -196,7 +203,10 @@ fn killed_while_writing_leaves_the_old_output_intact() {
         .filter_map(|e| e.ok())
         .map(|e| e.file_name().to_string_lossy().into_owned())
         .collect();
-    assert!(!names.iter().any(|n| n.starts_with(".kappe-out-")), "{names:?}");
+    assert!(
+        !names.iter().any(|n| n.starts_with(".kappe-out-")),
+        "{names:?}"
+    );
 }
 
 #[test]
@@ -305,7 +315,12 @@ fn exit_status_scheme() {
     assert!(stderr(&o).contains("empty"), "{}", stderr(&o));
     assert!(!tmp.path().join("o2").exists());
     let o = run(&["design", "missing.toml", "--out", "o3"]);
-    assert_eq!(code(&o), 3, "an unreadable file is an I/O failure: {}", stderr(&o));
+    assert_eq!(
+        code(&o),
+        3,
+        "an unreadable file is an I/O failure: {}",
+        stderr(&o)
+    );
     // 1: the design fails its checks (a too-flat long span crushes, issue 6's failing case);
     // the summary and report are written so the user sees why, the robot program is not.
     std::fs::write(
@@ -313,7 +328,14 @@ fn exit_status_scheme() {
         "[cap]\nspan = 1.4\nrise = 0.12\nlength = 0.15\n",
     )
     .unwrap();
-    let o = run(&["design", "fails.toml", "--out", "o4", "--quiet", "--no-buckling"]);
+    let o = run(&[
+        "design",
+        "fails.toml",
+        "--out",
+        "o4",
+        "--quiet",
+        "--no-buckling",
+    ]);
     assert_eq!(code(&o), 1, "{}", stderr(&o));
     assert!(tmp.path().join("o4/summary.json").is_file());
     assert!(tmp.path().join("o4/report.html").is_file());

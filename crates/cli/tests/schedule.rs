@@ -26,7 +26,10 @@ fn design_waits_reach_the_programs_and_the_schedule() {
 
     let csv = std::fs::read_to_string(out.join("schedule.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("layer,start_s,end_s,wait_s,relocation_s"));
+    assert_eq!(
+        lines.next(),
+        Some("layer,start_s,end_s,wait_s,relocation_s")
+    );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
@@ -35,7 +38,12 @@ fn design_waits_reach_the_programs_and_the_schedule() {
         // Every layer waits the scheduled time (CSV has 3 decimals), and the next layer starts
         // no earlier than the end of this one plus its wait.
         assert!((w[0][3] - wait).abs() < 1e-3, "layer {k}: wait {}", w[0][3]);
-        assert!(w[1][1] >= w[0][2] + wait - 1e-3, "layer {k}: {:?} → {:?}", w[0], w[1]);
+        assert!(
+            w[1][1] >= w[0][2] + wait - 1e-3,
+            "layer {k}: {:?} → {:?}",
+            w[0],
+            w[1]
+        );
     }
     // The same waits are pauses in the programs the operator runs.
     let mut sleeps = 0;
@@ -46,7 +54,10 @@ fn design_waits_reach_the_programs_and_the_schedule() {
             sleeps += text.matches(&format!("sleep({wait:.6})")).count();
         }
     }
-    assert!(sleeps >= layers - 1, "{sleeps} pauses of {wait} s for {layers} layers");
+    assert!(
+        sleeps >= layers - 1,
+        "{sleeps} pauses of {wait} s for {layers} layers"
+    );
     // One clock: the summary's print time spans the layers' times (first start to last end) on
     // the plan's clock (3-decimal CSV; the approach before the first layer is not counted).
     let total = summary["print_time_s"].as_f64().unwrap();

@@ -128,9 +128,15 @@ impl OptimizeFile {
         let Some(opt) = table.remove("optimize") else {
             // A design file (it has design tables but no `free`) without its [optimize] table:
             // say that, rather than "unknown field `cap`" from the optimize-file schema.
-            let design_tables = ["cap", "material", "print", "constraints", "robot", "analysis"];
-            if !table.contains_key("free") && design_tables.iter().any(|k| table.contains_key(*k))
-            {
+            let design_tables = [
+                "cap",
+                "material",
+                "print",
+                "constraints",
+                "robot",
+                "analysis",
+            ];
+            if !table.contains_key("free") && design_tables.iter().any(|k| table.contains_key(*k)) {
                 return Err(DesignError::Parse {
                     path: "optimize".into(),
                     message: "this is a design file without an [optimize] table: add \

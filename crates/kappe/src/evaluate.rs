@@ -255,9 +255,7 @@ impl Outcome {
     /// A `[schedule]` that does not fit the print ([`DesignError::Invalid`]).
     pub fn schedule(&self) -> Result<crate::schedule::Schedule, DesignError> {
         match &self.robot {
-            Some(Ok(plan)) => {
-                crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan))
-            }
+            Some(Ok(plan)) => crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan)),
             _ => crate::schedule::cap_schedule(&self.cap),
         }
     }

@@ -360,7 +360,10 @@ fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<
     spinner.finish_and_clear();
     let dir = prepared.path();
     let summary = out.summary();
-    std::fs::write(dir.join("ceiling.json"), serde_json::to_vec_pretty(&summary)?)?;
+    std::fs::write(
+        dir.join("ceiling.json"),
+        serde_json::to_vec_pretty(&summary)?,
+    )?;
     std::fs::write(dir.join("index.html"), out.index_html())?;
     for (i, bay) in out.bays.iter().enumerate() {
         let bay_dir = dir.join(format!("bay_{}", i + 1));
@@ -410,7 +413,11 @@ fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<
         let level = if args.allow_fail { "warning" } else { "error" };
         for (i, b) in out.bays.iter().enumerate() {
             if !b.outcome.ok {
-                eprintln!("{level}: bay {} fails its checks (see bay_{}/report.html)", i + 1, i + 1);
+                eprintln!(
+                    "{level}: bay {} fails its checks (see bay_{}/report.html)",
+                    i + 1,
+                    i + 1
+                );
             }
         }
         if !args.allow_fail {

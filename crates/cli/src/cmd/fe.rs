@@ -174,7 +174,8 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
         .buckling(&model, &options)
         .with_context(|| format!("buckling analysis of {source} failed"))?;
     let time_s = t0.elapsed().as_secs_f64();
-    if r.static_result.load_sum.iter().all(|v| *v == 0.0) && r.static_result.max_displacement == 0.0 {
+    if r.static_result.load_sum.iter().all(|v| *v == 0.0) && r.static_result.max_displacement == 0.0
+    {
         return Err(Usage(format!(
             "{source} has no load (gamma = 0 and no nodal loads): there is nothing to buckle"
         ))

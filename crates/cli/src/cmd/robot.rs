@@ -77,7 +77,11 @@ pub fn linted_programs(plan: &Plan, prefix: &str) -> Result<Vec<kappe_robot::Pro
 }
 
 /// Write a plan's outputs into `dir`: plan.json, trajectory.csv, the programs and their index.
-pub fn write_plan_outputs(dir: &Path, plan: &Plan, files: &[kappe_robot::ProgramFile]) -> Result<()> {
+pub fn write_plan_outputs(
+    dir: &Path,
+    plan: &Plan,
+    files: &[kappe_robot::ProgramFile],
+) -> Result<()> {
     let mut csv = Vec::new();
     write_trajectory_csv(plan, &mut csv)?;
     let mut json = Vec::new();
