@@ -301,7 +301,9 @@ fn v3(v: &crate::frame::V3) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
 
-fn parameters(cap: &Cap) -> Vec<Parameter> {
+/// `print_time`: the one print time of the run (`Outcome::print_time`: the robot plan's when
+/// there is one), so the page shows what the summary, the table and the programs show.
+fn parameters(cap: &Cap, print_time: f64) -> Vec<Parameter> {
     let d = &cap.design;
     let p = |key: &str, value: String, unit: &str| Parameter {
         key: key.into(),
@@ -364,7 +366,7 @@ fn parameters(cap: &Cap) -> Vec<Parameter> {
         p("start layers K", format!("{}", cap.sections.n_start), ""),
         p("catenary a", format!("{:.6}", cap.catenary.a), "m"),
         p("mass", format!("{:.2}", cap.path.mass), "kg"),
-        p("print time", format!("{:.1}", cap.path.time / 60.0), "min"),
+        p("print time", format!("{:.1}", print_time / 60.0), "min"),
     ]);
     out
 }
@@ -487,7 +489,7 @@ pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
 
     let mut input = ReportInput {
         name: d.name.clone(),
-        parameters: parameters(cap),
+        parameters: parameters(cap, extras.plan_end.unwrap_or(cap.path.time)),
         layers,
         bed_joints,
         print_path,
