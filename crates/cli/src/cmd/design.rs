@@ -56,22 +56,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
                 .with_context(|| format!("invalid design file {}", path.display()))?
         }
     };
-    // Analysis of every state: stresses, overhang, shell buckling (method.md §3).
-    let mut options = kappe::Options::of(&design);
-    if let Some(analysis) = options.analysis.as_mut() {
-        if let Some(states) = &args.states {
-            analysis.states = states
-                .parse()
-                .map_err(|e| Usage(format!("--states: {e}")))?;
-        }
-        if args.no_buckling {
-            analysis.buckling = false;
-        }
-    }
-    // Robot: planned (and verified inside the planner) unless disabled.
-    options.robot = !args.no_robot;
-    // A failing design gets no robot programs unless asked for (issue 16).
-    options.allow_fail = args.allow_fail;
+    let options = run_options(&args, &design)?;
     // Refusals and unwritable locations fail here, before any computing.
     let prepared = prepare_dir(&args.out, args.force, "design")?;
     let silent = args.quiet || args.json;
@@ -325,19 +310,13 @@ fn print_table(cap: &kappe::Cap, print_time: f64, out: &std::path::Path) {
 fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<ExitCode> {
     let ceiling = kappe::ceiling::CeilingDesign::from_toml_str(text)
         .with_context(|| format!("invalid ceiling file {}", path.display()))?;
-    let mut options = kappe::Options::of(&kappe::Design::default());
-    if let Some(analysis) = options.analysis.as_mut() {
-        if let Some(states) = &args.states {
-            analysis.states = states
-                .parse()
-                .map_err(|e| Usage(format!("--states: {e}")))?;
-        }
-        if args.no_buckling {
-            analysis.buckling = false;
-        }
-    }
-    options.robot = !args.no_robot;
-    options.allow_fail = args.allow_fail;
+    // The bays share the file's [analysis] and [robot]: the first bay's design carries them.
+    let first = ceiling
+        .bay_designs()?
+        .into_iter()
+        .next()
+        .unwrap_or_default();
+    let options = run_options(args, &first)?;
     let prepared = prepare_dir(&args.out, args.force, "design (ceiling)")?;
     let silent = args.quiet || args.json;
     let spinner = if silent {
@@ -425,4 +404,24 @@ fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What `kappe design` runs for `design`: the analysis of every state (stresses, overhang, shell
+/// buckling, method.md §3) from its `[analysis]` with the command-line overrides, the robot plan
+/// unless `--no-robot`, and robot programs for a failing design only with `--allow-fail`.
+fn run_options(args: &DesignArgs, design: &kappe::Design) -> Result<kappe::Options> {
+    let mut options = kappe::Options::of(design);
+    if let Some(analysis) = options.analysis.as_mut() {
+        if let Some(states) = &args.states {
+            analysis.states = states
+                .parse()
+                .map_err(|e| Usage(format!("--states: {e}")))?;
+        }
+        if args.no_buckling {
+            analysis.buckling = false;
+        }
+    }
+    options.robot = !args.no_robot;
+    options.allow_fail = args.allow_fail;
+    Ok(options)
 }
