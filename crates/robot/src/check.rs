@@ -38,23 +38,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         ..Default::default()
     };
     let mut problems = Vec::new();
-    let layers: Vec<PrintLayer> = plan
-        .stations
-        .iter()
-        .flat_map(|s| &s.layers)
-        .map(|l| PrintLayer {
-            layer: l.layer,
-            points: l
-                .waypoints
-                .iter()
-                .map(|w| PathPoint {
-                    index: w.index,
-                    position: w.position,
-                    axis: w.axis,
-                })
-                .collect(),
-        })
-        .collect();
+    let layers = crate::check::plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
@@ -307,4 +291,25 @@ fn check_rates(
         }
     }
     (rv, ra)
+}
+
+/// The print targets of a plan as the planner's input layers (every station's layers in print
+/// order), so a check can validate them with the planner's own rules.
+pub(crate) fn plan_layers(plan: &Plan) -> Vec<PrintLayer> {
+    plan.stations
+        .iter()
+        .flat_map(|s| &s.layers)
+        .map(|l| PrintLayer {
+            layer: l.layer,
+            points: l
+                .waypoints
+                .iter()
+                .map(|w| PathPoint {
+                    index: w.index,
+                    position: w.position,
+                    axis: w.axis,
+                })
+                .collect(),
+        })
+        .collect()
 }

@@ -21,7 +21,6 @@ use crate::error::RobotError;
 use crate::frames::Iso;
 use crate::kinematics::Joints;
 use crate::plan::{Plan, validate};
-use crate::setup::{PathPoint, PrintLayer};
 
 const STL: [&[u8]; 7] = [
     include_bytes!("../assets/ur10e/base.stl"),
@@ -240,23 +239,7 @@ fn better(a: &mut ClearanceAt, d: f64, at: (usize, i64, usize), what: &str, firs
 pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotError> {
     let stride = stride.max(1);
     let meshes = ArmMeshes::load()?;
-    let layers: Vec<PrintLayer> = plan
-        .stations
-        .iter()
-        .flat_map(|s| &s.layers)
-        .map(|l| PrintLayer {
-            layer: l.layer,
-            points: l
-                .waypoints
-                .iter()
-                .map(|w| PathPoint {
-                    index: w.index,
-                    position: w.position,
-                    axis: w.axis,
-                })
-                .collect(),
-        })
-        .collect();
+    let layers = crate::check::plan_layers(plan);
     let ctx = validate(&layers, &plan.setup, &plan.options)?;
     let tool_caps: Vec<_> = ctx
         .self_model

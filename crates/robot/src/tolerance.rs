@@ -29,7 +29,6 @@ use crate::collision::{Obstacle, Scene};
 use crate::frames::Iso;
 use crate::kinematics::joint_delta;
 use crate::plan::{Plan, validate};
-use crate::setup::{PathPoint, PrintLayer};
 
 /// The base-pose errors a plan must tolerate.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -108,23 +107,7 @@ pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport
         ));
         return rep;
     }
-    let layers: Vec<PrintLayer> = plan
-        .stations
-        .iter()
-        .flat_map(|s| &s.layers)
-        .map(|l| PrintLayer {
-            layer: l.layer,
-            points: l
-                .waypoints
-                .iter()
-                .map(|w| PathPoint {
-                    index: w.index,
-                    position: w.position,
-                    axis: w.axis,
-                })
-                .collect(),
-        })
-        .collect();
+    let layers = crate::check::plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
