@@ -23,6 +23,11 @@ case "$(basename "$wheel")" in
   *) echo "error: the wheel $(basename "$wheel") is not tagged cp39-abi3" >&2; exit 1 ;;
 esac
 "$venv/bin/python" -m pip install -q --force-reinstall --no-deps "$wheel"
+# The tests compare with the CLI built from the same sources: build (or refresh) it unless the
+# caller names a binary; a stale binary makes the "equals the CLI" tests fail.
+if [ -z "${KAPPE_BIN:-}" ]; then
+  cargo build --release -q -p kappe-cli
+fi
 export KAPPE_BIN="${KAPPE_BIN:-$root/target/release/kappe}"
 export KAPPE_WHEEL="$wheel"
 # From tests/: `python -m` puts the working directory on sys.path, and python/ holds the

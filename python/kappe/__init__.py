@@ -19,6 +19,7 @@ import copy
 import json
 import math
 from collections.abc import MutableMapping
+from functools import cached_property
 from typing import Any, Callable, Dict, Iterator, List, Mapping, Optional
 
 import numpy as np
@@ -31,7 +32,11 @@ __all__ = [
     "DesignError",
     "Result",
     "design",
+    "optimize",
+    "OptimizeResult",
     "study",
+    "ceiling",
+    "CeilingResult",
     "cem",
     "fe",
     "robot",
@@ -77,7 +82,10 @@ def _check_plain(value: Any, path: str) -> None:
         _check_plain(value.item(), path)
         return
     raise DesignError(
-        f"design field `{path}`: a {type(value).__name__} is not a design value", path, repr(value), "numbers, strings, lists, tables"
+        f"design field `{path}`: a {type(value).__name__} is not a design value",
+        path,
+        repr(value),
+        "numbers, strings, lists, tables",
     )
 
 
@@ -213,47 +221,170 @@ class Layer:
         self.segment_stress = np.asarray(data["segment_stress"], dtype=float)
         self.overhang: Optional[float] = data.get("overhang")
 
+    @classmethod
+    def _from_arrays(
+        cls, id: int, nodes: np.ndarray, forces: np.ndarray, stress: np.ndarray, overhang: Optional[float]
+    ) -> "Layer":
+        layer = cls.__new__(cls)
+        layer.id, layer.nodes, layer.segment_forces, layer.segment_stress = id, nodes, forces, stress
+        layer.overhang = overhang
+        return layer
+
+    @property
+    def __data__(self) -> Dict[str, Any]:
+        return {
+            "id": self.id,
+            "nodes": self.nodes.tolist(),
+            "segment_forces": self.segment_forces.tolist(),
+            "segment_stress": self.segment_stress.tolist(),
+            "overhang": self.overhang,
+        }
+
     def __repr__(self) -> str:
         return f"Layer(id={self.id}, nodes={len(self.nodes)})"
 
 
 class PrintPath:
-    """The print path: tip points (n×3, m), tool axes (n×3), layer id per point."""
+    """The print path: tip points (n×3, m), tool axes (n×3), layer id per point, the printed
+    length (m) and the time at the print speed (s)."""
 
     def __init__(self, data: Mapping[str, Any]) -> None:
         self.points = np.asarray(data["points"], dtype=float).reshape(-1, 3)
         self.axis = np.asarray(data["axis"], dtype=float).reshape(-1, 3)
         self.layer = np.asarray(data["layer"], dtype=int)
         self.length: float = data["print_length_m"]
+        self.time: float = data.get("time_s", float("nan"))
+
+    @classmethod
+    def _from_arrays(
+        cls, points: np.ndarray, axis: np.ndarray, layer: np.ndarray, length: float, time: float
+    ) -> "PrintPath":
+        path = cls.__new__(cls)
+        path.points, path.axis, path.layer, path.length, path.time = points, axis, layer, length, time
+        return path
+
+    @property
+    def __data__(self) -> Dict[str, Any]:
+        return {
+            "points": self.points.tolist(),
+            "axis": self.axis.tolist(),
+            "layer": self.layer.tolist(),
+            "print_length_m": self.length,
+            "time_s": self.time,
+        }
 
 
 class Result(_CompasData):
     """What :func:`design` found: ``summary`` (the dict ``kappe design`` writes as
     summary.json), ``ok`` (the verdict), ``states`` (one dict per print state), ``layers``,
     ``path``, ``trajectory`` (time and joints of the robot plan, or None), ``constraints``
-    (the constraint report), ``network`` (the final state's network) and ``report_html``."""
+    (the constraint report), ``network`` (the final state's network) and ``report_html``.
+
+    Each part is converted from the native result when first read (arrays straight from
+    Rust's vectors), so a run costs what ``kappe design``'s does."""
 
     dtype = "kappe/Result"
 
-    def __init__(self, data: Mapping[str, Any]) -> None:
-        self._data = dict(data)
-        self.summary: Dict[str, Any] = data["summary"]
-        self.ok: bool = data["ok"]
-        self.print_time: float = data["print_time_s"]
-        self.states: List[Dict[str, Any]] = self.summary.get("states", [])
-        self.constraints: List[Dict[str, Any]] = data["constraints"]
-        self.layers = [Layer(x) for x in data["layers"]]
-        self.path = PrintPath(data["path"])
-        self.network: Dict[str, Any] = data["network"]
-        self.report_html: Optional[str] = data.get("report_html")
-        csv = data.get("trajectory_csv")
-        self.trajectory_header: List[str] = []
-        self.trajectory: Optional[np.ndarray] = None
-        if csv:
-            lines = [l for l in csv.splitlines() if l and not l.startswith("#")]
-            self.trajectory_header = lines[0].split(",")
-            rows = [[float(x) for x in l.split(",")] for l in lines[1:]]
-            self.trajectory = np.asarray(rows, dtype=float)
+    _KEYS = (
+        "summary",
+        "ok",
+        "print_time_s",
+        "constraints",
+        "layers",
+        "path",
+        "trajectory_csv",
+        "network",
+        "report_html",
+    )
+
+    def __init__(self, data: Optional[Mapping[str, Any]] = None, _native: Any = None) -> None:
+        self._native = _native
+        self._data: Dict[str, Any] = dict(data or {})
+        if _native is None:
+            missing = [k for k in ("summary", "ok", "print_time_s") if k not in self._data]
+            if missing:
+                raise ValueError(f"Result data: missing {', '.join(missing)}")
+
+    def _raw(self, key: str, native: Callable[[Any], Any], default: Any = None) -> Any:
+        if self._native is not None:
+            return native(self._native)
+        return self._data.get(key, default)
+
+    @cached_property
+    def summary(self) -> Dict[str, Any]:
+        return self._raw("summary", lambda n: json.loads(n.summary_json()))
+
+    @property
+    def ok(self) -> bool:
+        return bool(self._raw("ok", lambda n: n.ok))
+
+    def write(self, directory: str, force: bool = False) -> Optional[str]:
+        """Write the output directory ``kappe design --out`` writes (the same files, by the
+        same library code): a new directory, or one Kappe wrote, is replaced atomically;
+        anything else raises ``ValueError`` unless ``force``, which moves it aside (nothing is
+        deleted). Returns a notice when something was moved aside."""
+        if self._native is None:
+            raise ValueError("this Result was restored from data; run kappe.design() to write its files")
+        return _kappe.write_output(directory, self._native.files(), force, "python design")
+
+    @property
+    def print_time(self) -> float:
+        return float(self._raw("print_time_s", lambda n: n.print_time))
+
+    @property
+    def states(self) -> List[Dict[str, Any]]:
+        return self.summary.get("states", [])
+
+    @cached_property
+    def constraints(self) -> List[Dict[str, Any]]:
+        return self._raw("constraints", lambda n: json.loads(n.constraints_json()), [])
+
+    @cached_property
+    def layers(self) -> List[Layer]:
+        if self._native is not None:
+            return [Layer._from_arrays(*t) for t in self._native.layers()]
+        return [Layer(x) for x in self._data.get("layers", [])]
+
+    @cached_property
+    def path(self) -> PrintPath:
+        if self._native is not None:
+            return PrintPath._from_arrays(*self._native.path())
+        return PrintPath(self._data["path"])
+
+    @cached_property
+    def network(self) -> Dict[str, Any]:
+        return self._raw("network", lambda n: json.loads(n.network_json()), {})
+
+    @cached_property
+    def report_html(self) -> Optional[str]:
+        return self._raw("report_html", lambda n: n.report_html())
+
+    @cached_property
+    def trajectory_csv(self) -> Optional[str]:
+        """trajectory.csv as ``kappe design`` writes it (None without a robot plan)."""
+        return self._raw("trajectory_csv", lambda n: n.trajectory_csv())
+
+    @cached_property
+    def _trajectory(self) -> Any:
+        if self._native is not None:
+            return self._native.trajectory()
+        csv = self._data.get("trajectory_csv")
+        if not csv:
+            return None
+        lines = [line for line in csv.splitlines() if line and not line.startswith("#")]
+        rows = [[float(x) for x in line.split(",")] for line in lines[1:]]
+        return lines[0].split(","), np.asarray(rows, dtype=float).reshape(len(rows), -1)
+
+    @property
+    def trajectory(self) -> Optional[np.ndarray]:
+        """The robot plan's trajectory (rows × columns of ``trajectory_header``), or None."""
+        t = self._trajectory
+        return None if t is None else t[1]
+
+    @property
+    def trajectory_header(self) -> List[str]:
+        t = self._trajectory
+        return [] if t is None else list(t[0])
 
     @property
     def node_xyz(self) -> np.ndarray:
@@ -267,7 +398,17 @@ class Result(_CompasData):
 
     @property
     def __data__(self) -> Dict[str, Any]:
-        return dict(self._data)
+        return {
+            "summary": self.summary,
+            "ok": self.ok,
+            "print_time_s": self.print_time,
+            "constraints": self.constraints,
+            "layers": [layer.__data__ for layer in self.layers],
+            "path": self.path.__data__,
+            "trajectory_csv": self.trajectory_csv,
+            "network": self.network,
+            "report_html": self.report_html,
+        }
 
     @classmethod
     def __from_data__(cls, data: Mapping[str, Any]) -> "Result":
@@ -302,12 +443,14 @@ def design(
         _check_plain(dict(analysis), "analysis")
         analysis_json = json.dumps(_plain(dict(analysis)), allow_nan=False)
     else:
-        raise TypeError("analysis: expected \"design\", None or a dict of analysis options")
+        raise TypeError('analysis: expected "design", None or a dict of analysis options')
     if progress is not None and not callable(progress):
         raise TypeError("progress: expected a callable progress(stage, done, total)")
-    text = _kappe.run_design(d.to_toml(), analysis_json, bool(robot), bool(allow_fail), progress, bool(report))
-    return Result(json.loads(text))
+    native = _kappe.run_design(d.to_toml(), analysis_json, bool(robot), bool(allow_fail), progress, bool(report))
+    return Result(_native=native)
 
 
 from . import cem, fe, robot  # noqa: E402  (submodules use the names above)
+from ._ceiling import CeilingResult, ceiling  # noqa: E402
+from ._optimize import OptimizeResult, optimize  # noqa: E402
 from ._study import study  # noqa: E402

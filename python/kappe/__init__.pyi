@@ -2,8 +2,14 @@ from typing import Any, Callable, Dict, List, Mapping, MutableMapping, Optional,
 
 import numpy as np
 
-from . import cem as cem, fe as fe, robot as robot
-from ._study import StudyResult, study as study
+from . import cem as cem
+from . import fe as fe
+from . import robot as robot
+from ._ceiling import CeilingResult as CeilingResult
+from ._ceiling import ceiling as ceiling
+from ._optimize import OptimizeResult as OptimizeResult
+from ._optimize import optimize as optimize
+from ._study import study as study
 
 __version__: str
 
@@ -46,6 +52,7 @@ class PrintPath:
     axis: np.ndarray
     layer: np.ndarray
     length: float
+    time: float
 
 class Result:
     dtype: str
@@ -58,6 +65,7 @@ class Result:
     path: PrintPath
     network: Dict[str, Any]
     report_html: Optional[str]
+    trajectory_csv: Optional[str]
     trajectory_header: List[str]
     trajectory: Optional[np.ndarray]
     @property
@@ -68,6 +76,7 @@ class Result:
     def __data__(self) -> Dict[str, Any]: ...
     @classmethod
     def __from_data__(cls, data: Mapping[str, Any]) -> Result: ...
+    def write(self, directory: str, force: bool = ...) -> Optional[str]: ...
 
 def design(
     design: Union[Design, Mapping[str, Any], str, None] = ...,

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import os
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Dict, List, Optional
 
 from . import _kappe
@@ -29,24 +28,24 @@ class StudyResult:
         self.rows: List[Dict[str, Any]] = self.data["rows"]
         self.csv = csv
         self.html = html
+        self._runs = runs
         self.summaries = {r["record"]["name"]: r["summary"] for r in runs}
         self.reports = {r["record"]["name"]: r["report_html"] for r in runs}
 
-    def write(self, directory: str) -> None:
-        """Writes study.json, study.csv, study.html and designs/<name>/ like ``kappe study``."""
-        os.makedirs(os.path.join(directory, "designs"), exist_ok=True)
-        for name, text in (("study.json", self.json), ("study.csv", self.csv), ("study.html", self.html)):
-            with open(os.path.join(directory, name), "w", encoding="utf-8") as f:
-                f.write(text)
-        for name, summary in self.summaries.items():
-            d = os.path.join(directory, "designs", name)
-            os.makedirs(d, exist_ok=True)
-            if summary is not None:
-                with open(os.path.join(d, "summary.json"), "w", encoding="utf-8") as f:
-                    json.dump(summary, f, indent=2)
-            if self.reports.get(name):
-                with open(os.path.join(d, "report.html"), "w", encoding="utf-8") as f:
-                    f.write(self.reports[name])
+    def write(self, directory: str, force: bool = False) -> Optional[str]:
+        """Writes study.json, study.csv, study.html and designs/<name>/{design.toml,
+        summary.json, report.html} as ``kappe study`` does (the same bytes), under its rule: a
+        new directory, or one Kappe wrote, is replaced atomically; anything else raises
+        ``ValueError`` unless ``force``, which moves it aside (nothing is deleted)."""
+        files = [
+            (name, text.encode())
+            for name, text in (("study.json", self.json), ("study.csv", self.csv), ("study.html", self.html))
+        ]
+        # Per design the files `kappe study` writes, made by the same library functions
+        # (design.toml, summary.json, report.html): the same bytes.
+        for run in self._runs:
+            files.extend((name, text.encode()) for name, text in run.get("files", []))
+        return _kappe.write_output(directory, files, force, "python study")
 
     def __repr__(self) -> str:
         return f"StudyResult(designs={len(self.rows)})"
@@ -59,8 +58,9 @@ def study(
     jobs: Optional[int] = None,
 ) -> StudyResult:
     """Run a study: ``study`` is a path to a study file or its TOML text. Locally the designs
-    run in parallel threads (Kappe releases the GIL); with ``client`` (a
-    ``dask.distributed.Client``) one task per design runs on the cluster."""
+    run in parallel on ``jobs`` threads (default one per core; the GIL is released), exactly as
+    ``kappe study`` runs them; with ``client`` (a ``dask.distributed.Client``) one task per
+    design runs on the cluster."""
     if not isinstance(study, str):
         raise TypeError(f"study: expected a path or TOML text, got {type(study).__name__}")
     if os.path.isfile(study):
@@ -69,17 +69,15 @@ def study(
         source, directory = os.path.basename(study), os.path.dirname(os.path.abspath(study))
     else:
         text, source, directory = study, "study.toml", os.getcwd()
-    parsed = json.loads(_kappe.study_parse(text, source, directory))
-    indices = [d["index"] for d in parsed["designs"]]
     if client is not None:
-        futures = client.map(_run_one, [text] * len(indices), indices, [no_robot] * len(indices),
-                             [source] * len(indices), [directory] * len(indices), pure=False)
-        outputs = client.gather(futures)
+        parsed = json.loads(_kappe.study_parse(text, source, directory))
+        indices = [d["index"] for d in parsed["designs"]]
+        n = len(indices)
+        futures = client.map(_run_one, [text] * n, indices, [no_robot] * n, [source] * n, [directory] * n, pure=False)
+        runs = [json.loads(o) for o in client.gather(futures)]
     else:
-        workers = jobs or os.cpu_count() or 1
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            outputs = list(pool.map(lambda i: _run_one(text, i, no_robot, source, directory), indices))
-    runs = [json.loads(o) for o in outputs]
+        # The same parallel run as `kappe study` (Rust threads, the GIL released).
+        runs = json.loads(_kappe.study_run_local(text, no_robot, jobs, source, directory))
     records = json.dumps([r["record"] for r in runs])
     study_json, csv, html = _kappe.study_collect(text, records, no_robot, source, directory)
     return StudyResult(study_json, csv, html, runs)

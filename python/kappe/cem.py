@@ -27,7 +27,9 @@ def solve(topology: Union[str, Mapping[str, Any]], force_polygons: bool = False)
 
 def optimize(topology: Union[str, Mapping[str, Any]]) -> Dict[str, Any]:
     """Constrained form-finding of a topology with an ``optimization`` block:
-    ``{"converged", "status", "objective", "equilibrium"}``."""
+    ``{"converged", "status", "objective", "equilibrium", "report"}``; ``equilibrium`` is the
+    document ``kappe cem optimize`` writes (with its ``optimization`` block), ``report`` the
+    text it prints."""
     return json.loads(_kappe.cem_optimize(_text(topology)))
 
 
@@ -40,12 +42,5 @@ class Topology:
         self._native = _kappe.Topology(_text(topology))
 
     def solve(self) -> Dict[str, Any]:
-        import numpy as np
-
-        xyz, trail, deviation, reactions = self._native.solve()
-        return {
-            "xyz": np.asarray(xyz, dtype=float).reshape(-1, 3),
-            "trail_forces": np.asarray(trail, dtype=float),
-            "deviation_forces": np.asarray(deviation, dtype=float),
-            "reactions": np.asarray(reactions, dtype=float).reshape(-1, 3),
-        }
+        """The arrays, made in Rust from the solver's vectors (no lists, no copy)."""
+        return self._native.solve()

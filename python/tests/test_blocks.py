@@ -3,9 +3,9 @@ import subprocess
 
 import numpy as np
 import pytest
+from conftest import FIXTURES
 
 import kappe
-from conftest import FIXTURES
 
 
 def test_cem_fixture_equals_the_cli(tmp_path, kappe_bin):
@@ -30,6 +30,34 @@ def test_fe_buckle_plate():
     assert r["factors"].shape == (2,) and np.all(r["factors"] > 0)
     with pytest.raises(ValueError):
         kappe.fe.buckle(mesh, modes=0)
+
+
+def test_fe_buckle_equals_the_cli(tmp_path, kappe_bin):
+    src = FIXTURES / "fe" / "plate_ss_s3_n16.mesh.json"
+    out = tmp_path / "b.json"
+    subprocess.run([kappe_bin, "fe", "buckle", str(src), "--modes", "2", "--mode-shapes", "-o", str(out)], check=True)
+    cli = json.loads(out.read_text())
+    py = kappe.fe.buckle(json.loads(src.read_text()), modes=2)
+    # The same library call on the same model: the numbers are equal, not close (the CLI's
+    # JSON prints shortest round-trip floats). Wall-clock times differ.
+    assert py["factors"].tolist() == cli["factors"]
+    assert [m.tolist() for m in py["modes"]] == cli["modes"]
+    for key in ("static", "dofs", "residuals", "mesh_quality", "sturm"):
+        assert py[key] == cli[key], key
+    assert py["solver"]["element_kind"] == cli["solver"]["element_kind"]
+
+
+def test_fe_static_equals_the_cli(tmp_path, kappe_bin):
+    src = FIXTURES / "fe" / "plate_ss_s3_n16.mesh.json"
+    out = tmp_path / "s.json"
+    subprocess.run([kappe_bin, "fe", "static", str(src), "-o", str(out)], check=True)
+    cli = json.loads(out.read_text())
+    py = kappe.fe.static(json.loads(src.read_text()))
+    # The same library call: equal numbers (shortest round-trip floats in the CLI's JSON).
+    assert py["displacements"].shape == (len(cli["displacements"]), 6)
+    assert py["displacements"].tolist() == cli["displacements"]
+    for key in ("static", "dofs", "element", "mesh_quality", "reactions", "elements"):
+        assert py[key] == cli[key], key
 
 
 def test_robot_ik_solutions_reach_the_pose():

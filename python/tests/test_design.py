@@ -4,9 +4,9 @@ import subprocess
 
 import numpy as np
 import pytest
+from conftest import CHEAP
 
 import kappe
-from conftest import CHEAP
 
 
 def test_default_design_has_every_field_and_round_trips():
@@ -82,7 +82,7 @@ def test_analysis_options_are_checked():
 
 def test_compas_round_trip(tmp_path):
     compas = pytest.importorskip("compas")
-    import compas.data  # noqa: F401
+    import compas.data  # noqa: F401, F811  (registers the data classes)
 
     d = kappe.Design(CHEAP)
     path = tmp_path / "d.json"

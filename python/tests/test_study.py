@@ -1,5 +1,4 @@
 import json
-import os
 import subprocess
 
 import pytest
@@ -31,6 +30,32 @@ def test_local_study_equals_the_cli(tmp_path, kappe_bin):
     assert r.csv == cli_csv
     assert json.loads(r.json)["rows"] == json.loads(cli_json)["rows"]
     assert len(r.rows) == 4
+
+
+def test_written_study_equals_the_cli_output(tmp_path, kappe_bin):
+    cli_rows(tmp_path, kappe_bin)
+    r = kappe.study(str(tmp_path / "s.toml"), no_robot=True)
+    r.write(str(tmp_path / "py"))
+
+    def tree(root):
+        # `.kappe-output.json` is Kappe's manifest of its outputs: it names the command.
+        return {
+            p.relative_to(root).as_posix(): p.read_bytes()
+            for p in root.rglob("*")
+            if p.is_file() and p.name != ".kappe-output.json"
+        }
+
+    cli, py = tree(tmp_path / "cli"), tree(tmp_path / "py")
+    assert sorted(py) == sorted(cli)
+    for name, data in cli.items():
+        if name.endswith("summary.json"):
+            # The wall-clock analysis timings differ between two runs; the rest is equal.
+            a, b = json.loads(data), json.loads(py[name])
+            a.pop("analysis_timings_s", None)
+            b.pop("analysis_timings_s", None)
+            assert a == b, name
+        else:
+            assert py[name] == data, name
 
 
 def test_dask_study_equals_the_cli(tmp_path, kappe_bin):

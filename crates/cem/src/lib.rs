@@ -46,6 +46,7 @@ pub mod fixed_geometry;
 pub mod json;
 pub mod model;
 pub mod optimize;
+pub mod report;
 pub mod topology;
 
 pub use equilibrium::{

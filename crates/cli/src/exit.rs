@@ -29,11 +29,6 @@ pub fn fails() -> ExitCode {
 #[error("{0}")]
 pub struct Usage(pub String);
 
-/// A file-system failure found by the CLI itself (status 3).
-#[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct IoFailure(pub String);
-
 /// The status for an error: the first error in the chain of a known kind decides.
 pub fn status_of(err: &anyhow::Error) -> u8 {
     for cause in err.chain() {
@@ -45,65 +40,14 @@ pub fn status_of(err: &anyhow::Error) -> u8 {
 }
 
 fn status_of_cause(cause: &(dyn std::error::Error + 'static)) -> Option<u8> {
-    use kappe::DesignError;
-    use kappe_cem::CemError;
-    use kappe_fe::FeError;
-    use kappe_robot::RobotError;
-
     if cause.is::<Usage>() {
         return Some(USAGE);
     }
-    if cause.is::<IoFailure>() || cause.is::<std::io::Error>() {
-        return Some(INTERNAL);
-    }
-    if cause.is::<toml::de::Error>() || cause.is::<serde_json::Error>() {
-        return Some(USAGE);
-    }
-    if let Some(e) = cause.downcast_ref::<DesignError>() {
-        return Some(match e {
-            DesignError::Parse { .. } | DesignError::Invalid { .. } => USAGE,
-            // The design as given has no equilibrium form within its bounds: it fails.
-            DesignError::FormFinding(_) => FAILS,
-            DesignError::Cem(inner) => cem_status(inner),
-            _ => INTERNAL,
-        });
-    }
-    if let Some(e) = cause.downcast_ref::<CemError>() {
-        return Some(cem_status(e));
-    }
-    if let Some(e) = cause.downcast_ref::<FeError>() {
-        return Some(match e {
-            FeError::SturmMismatch { .. }
-            | FeError::NoConvergence { .. }
-            | FeError::Numerical { .. }
-            | FeError::PatternMismatch { .. } => INTERNAL,
-            _ => USAGE,
-        });
-    }
-    if let Some(e) = cause.downcast_ref::<RobotError>() {
-        return Some(match e {
-            RobotError::Invalid { .. } => USAGE,
-            RobotError::Io(_) => INTERNAL,
-            // The robot cannot print it, or the plan fails its independent check.
-            _ => FAILS,
-        });
-    }
-    if cause.is::<kappe::study::StudyError>() {
-        return Some(USAGE);
-    }
-    if cause.is::<kappe_report::ReportError>() {
-        return Some(INTERNAL);
-    }
-    None
-}
-
-fn cem_status(e: &kappe_cem::CemError) -> u8 {
-    use kappe_cem::CemError;
-    match e {
-        CemError::NotConverged { .. } => FAILS,
-        CemError::NumericalBreakdown { .. } => INTERNAL,
-        _ => USAGE,
-    }
+    kappe::error::class_of(cause).map(|class| match class {
+        kappe::error::Class::Input => USAGE,
+        kappe::error::Class::Fails => FAILS,
+        kappe::error::Class::Internal => INTERNAL,
+    })
 }
 
 /// Panics are internal errors: print the usual message, then exit with [`INTERNAL`] instead of

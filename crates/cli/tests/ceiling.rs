@@ -3,22 +3,11 @@
 
 use std::process::Command;
 
-const SMALL: &str = r#"
-name = "small room"
-[ceiling]
-length = 0.5
-ends = "both_walls"
-rise_ratio = 0.25
-[[bay]]
-span = 0.4
-[[bay]]
-span = 0.5
-[[bay]]
-name = "narrow"
-span = 0.35
-[print]
-path_sampling = 0.04
-"#;
+/// The three-bay room shared with the other ceiling tests.
+const SMALL: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../kappe/tests/data/small_room.toml"
+));
 
 #[test]
 fn design_runs_a_three_bay_ceiling() {

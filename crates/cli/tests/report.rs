@@ -198,6 +198,21 @@ fn report_input_matches_closed_forms_and_the_summary() {
     assert!(!cell.stations.is_empty());
     let timeline = input.timeline.as_ref().unwrap();
     assert_eq!(timeline.point_time.len(), input.print_path.points.len());
+    // The robot section: the tool speed and the clearances of both models, the meshes' next to
+    // the capsules', with the certified bound along the motion never above the waypoints' value.
+    let summary = input.robot_summary.as_ref().unwrap();
+    assert!(html.contains("id=\"robot-check\""));
+    let models: Vec<&str> = summary
+        .clearances
+        .iter()
+        .map(|c| c.model.as_str())
+        .collect();
+    assert!(models.contains(&"arm meshes (UR)") && models.contains(&"arm capsules"));
+    for c in &summary.clearances {
+        if let Some(along) = c.along_motion {
+            assert!(along <= c.at_waypoints + 1e-12, "{c:?}");
+        }
+    }
 }
 
 #[test]

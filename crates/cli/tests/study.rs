@@ -2,8 +2,10 @@
 //! against the unsharded study, and bad study files.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
+
+mod common;
 
 const KAPPE: &str = env!("CARGO_BIN_EXE_kappe");
 
@@ -221,26 +223,6 @@ fn grid_reproduces_kappe_design_row_by_row() {
     assert!(html.contains("cell-fail"));
 }
 
-/// Every file under `dir`, relative path → bytes.
-fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(
-                    p.strip_prefix(root).unwrap().to_path_buf(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(dir, dir, &mut out);
-    out
-}
-
 #[test]
 fn shards_merged_equal_the_unsharded_study() {
     let tmp = tempfile::tempdir().unwrap();
@@ -290,38 +272,8 @@ fn shards_merged_equal_the_unsharded_study() {
         ],
         work,
     ));
-    // The output manifest (`.kappe-output.json`, Kappe's marker of its own directories) names
-    // the command that wrote it; every other file must be byte-identical.
-    let manifest = |mut t: BTreeMap<PathBuf, Vec<u8>>| {
-        t.remove(Path::new(".kappe-output.json"));
-        t
-    };
-    let a = manifest(tree(&work.join("all")));
-    let b = manifest(tree(&work.join("merged")));
-    assert_eq!(
-        a.keys().collect::<Vec<_>>(),
-        b.keys().collect::<Vec<_>>(),
-        "same files"
-    );
-    // summary.json holds the wall-clock time of each design's analysis (`analysis_timings_s`),
-    // which differs between two runs of the same design; everything else is byte-identical.
-    let without_timings = |bytes: &[u8]| {
-        let mut v: serde_json::Value = serde_json::from_slice(bytes).unwrap();
-        v.as_object_mut().unwrap().remove("analysis_timings_s");
-        v
-    };
-    for (path, bytes) in &a {
-        if path.ends_with("summary.json") {
-            assert_eq!(
-                without_timings(&b[path]),
-                without_timings(bytes),
-                "{} differs",
-                path.display()
-            );
-        } else {
-            assert!(b[path] == *bytes, "{} differs", path.display());
-        }
-    }
+    // Every file byte-identical but the manifest and the analysis wall-clock timings.
+    common::assert_same_outputs(&work.join("all"), &work.join("merged"));
 
     // A missing shard is an error naming the gap; --allow-incomplete merges what is there.
     let missing = kappe(

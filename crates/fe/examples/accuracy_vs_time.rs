@@ -16,11 +16,10 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::Instant;
 
 use kappe_fe::generate::barrel_vault;
-use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, FeError};
+use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, FeError, ccx};
 
 /// CalculiX S8R converged λ₁ of the vault (`fixtures/fe/vault_s3_20x12.expected.json`).
 const S8R: f64 = 0.068970;
@@ -88,49 +87,21 @@ fn s8r_deck(na: usize, nl: usize, scale: f64) -> (String, usize) {
             );
         }
     }
-    s.push_str("*NSET, NSET=SUP\n");
-    let sup: Vec<String> = (0..=nj)
-        .flat_map(|j| [at(0, j), at(ni, j)])
-        .filter(|&k| k > 0)
-        .map(|k| k.to_string())
-        .collect();
-    for chunk in sup.chunks(10) {
-        let _ = writeln!(s, "{}", chunk.join(", "));
-    }
-    let g = 9.81;
-    let _ = write!(
-        s,
-        "*BOUNDARY\nSUP, 1, 3\n*MATERIAL, NAME=CLAY\n*ELASTIC\n1e6, 0.3\n*DENSITY\n{:e}\n\
-         *SHELL SECTION, ELSET=EALL, MATERIAL=CLAY\n0.02\n*STEP\n*BUCKLE\n3, 1e-6\n\
-         *DLOAD\nEALL, GRAV, {:.8e}, 0., 0., -1.\n*END STEP\n",
-        23_044.0 / g,
-        g * scale
+    ccx::write_supports(
+        &mut s,
+        (0..=nj)
+            .flat_map(|j| [at(0, j), at(ni, j)])
+            .filter(|&k| k > 0),
     );
-    (s, n)
-}
-
-/// Buckling factors from the ccx `.dat` file.
-fn factors(dat: &Path) -> Vec<f64> {
-    let Ok(text) = std::fs::read_to_string(dat) else {
-        return Vec::new();
+    let step = ccx::BuckleStep {
+        youngs_modulus: 1e6,
+        poisson_ratio: 0.3,
+        unit_weight: 23_044.0,
+        thickness: 0.02,
+        modes: 3,
     };
-    let mut out = Vec::new();
-    let mut on = false;
-    for line in text.lines() {
-        if line.contains("B U C K L I N G") {
-            on = true;
-            continue;
-        }
-        if on {
-            let w: Vec<&str> = line.split_whitespace().collect();
-            if let [a, b] = w.as_slice()
-                && let (Ok(_), Ok(f)) = (a.parse::<usize>(), b.parse::<f64>())
-            {
-                out.push(f);
-            }
-        }
-    }
-    out
+    ccx::write_buckle_step(&mut s, &step, scale);
+    (s, n)
 }
 
 /// One ccx run of the S8R vault with the load scaled by `scale`: (wall s, λ's, nodes).
@@ -141,20 +112,7 @@ fn ccx_run(
     scale: f64,
 ) -> Result<(f64, Vec<f64>, usize), Box<dyn std::error::Error>> {
     let (deck, nodes) = s8r_deck(na, nl, scale);
-    std::fs::write(dir.join("vault_s8r.inp"), deck)?;
-    let t = Instant::now();
-    Command::new("ccx")
-        .arg("vault_s8r")
-        .current_dir(dir)
-        .env("OMP_NUM_THREADS", "2")
-        .env("CCX_NPROC_EQUATION_SOLVER", "2")
-        .stdout(std::process::Stdio::null())
-        .status()?;
-    let wall = t.elapsed().as_secs_f64();
-    let f = factors(&dir.join("vault_s8r.dat"))
-        .into_iter()
-        .map(|x| x * scale)
-        .collect();
+    let (wall, f, _) = ccx::run(dir, "vault_s8r", &deck, scale)?;
     Ok((wall, f, nodes))
 }
 

@@ -9,89 +9,36 @@
 //! ccx expands S3/S4 shells to one layer of C3D6/C3D8I solids (3 nodes through the thickness
 //! per shell node, 3 DOF each), SPOOLES factorisation + ARPACK shift-invert (buckling.md §8).
 
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use kappe_fe::generate::barrel_vault;
-use kappe_fe::{BucklingOptions, ShellModel, buckling};
+use kappe_fe::{BucklingOptions, ShellModel, buckling, ccx};
 
 fn deck(m: &ShellModel, n_arc: usize, n_len: usize, quads: bool, scale: f64) -> String {
-    let mut s = String::from("*HEADING\nkappe-fe benchmark vault\n*NODE\n");
-    for (i, p) in m.nodes.iter().enumerate() {
-        let _ = writeln!(s, "{}, {:.12e}, {:.12e}, {:.12e}", i + 1, p[0], p[1], p[2]);
-    }
+    let mut s = String::from("*HEADING\nkappe-fe benchmark vault\n");
+    ccx::write_nodes(&mut s, &m.nodes);
     if quads {
-        s.push_str("*ELEMENT, TYPE=S4, ELSET=EALL\n");
         let id = |i: usize, j: usize| j * (n_arc + 1) + i + 1;
-        let mut e = 1;
-        for j in 0..n_len {
-            for i in 0..n_arc {
-                let _ = writeln!(
-                    s,
-                    "{e}, {}, {}, {}, {}",
-                    id(i, j),
-                    id(i + 1, j),
-                    id(i + 1, j + 1),
-                    id(i, j + 1)
-                );
-                e += 1;
-            }
-        }
+        let quads = (0..n_len).flat_map(|j| {
+            (0..n_arc).map(move |i| vec![id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)])
+        });
+        ccx::write_elements(&mut s, "S4", quads);
     } else {
-        s.push_str("*ELEMENT, TYPE=S3, ELSET=EALL\n");
-        for (e, t) in m.triangles.iter().enumerate() {
-            let _ = writeln!(s, "{}, {}, {}, {}", e + 1, t[0] + 1, t[1] + 1, t[2] + 1);
-        }
+        let tris = m
+            .triangles
+            .iter()
+            .map(|t| t.iter().map(|n| n + 1).collect());
+        ccx::write_elements(&mut s, "S3", tris);
     }
-    s.push_str("*NSET, NSET=SUP\n");
     let fixed = m.fixed_mask();
-    let sup: Vec<String> = (0..m.nodes.len())
-        .filter(|&n| fixed[n][0])
-        .map(|n| (n + 1).to_string())
-        .collect();
-    for chunk in sup.chunks(10) {
-        let _ = writeln!(s, "{}", chunk.join(", "));
-    }
-    let mat = m.materials[0];
-    let g = 9.81;
-    let _ = write!(
-        s,
-        "*BOUNDARY\nSUP, 1, 3\n*MATERIAL, NAME=CLAY\n*ELASTIC\n{:e}, {}\n*DENSITY\n{:e}\n\
-         *SHELL SECTION, ELSET=EALL, MATERIAL=CLAY\n{}\n*STEP\n*BUCKLE\n3, 1e-6\n\
-         *DLOAD\nEALL, GRAV, {:.8e}, 0., 0., -1.\n*END STEP\n",
-        mat.youngs_modulus,
-        mat.poisson_ratio,
-        mat.unit_weight / g,
-        m.thickness[0],
-        g * scale
+    ccx::write_supports(
+        &mut s,
+        (0..m.nodes.len()).filter(|&n| fixed[n][0]).map(|n| n + 1),
     );
+    let step = ccx::BuckleStep::of(m, 3);
+    ccx::write_buckle_step(&mut s, &step, scale);
     s
-}
-
-/// Buckling factors from the ccx `.dat` file.
-fn factors(dat: &Path) -> Vec<f64> {
-    let Ok(text) = std::fs::read_to_string(dat) else {
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    let mut on = false;
-    for line in text.lines() {
-        if line.contains("B U C K L I N G") {
-            on = true;
-            continue;
-        }
-        if on {
-            let w: Vec<&str> = line.split_whitespace().collect();
-            if let [a, b] = w.as_slice()
-                && let (Ok(_), Ok(f)) = (a.parse::<usize>(), b.parse::<f64>())
-            {
-                out.push(f);
-            }
-        }
-    }
-    out
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -125,35 +72,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             "S3 (→ C3D6)"
         };
-        let run = |scale: f64| -> Result<(f64, Vec<f64>, bool), Box<dyn std::error::Error>> {
-            std::fs::write(
-                dir.join(format!("{name}.inp")),
-                deck(&m, n_arc, n_len, quads, scale),
-            )?;
-            let t = Instant::now();
-            let status = Command::new("ccx")
-                .arg(name)
-                .current_dir(&dir)
-                .env("OMP_NUM_THREADS", "2")
-                .env("CCX_NPROC_EQUATION_SOLVER", "2")
-                .stdout(std::process::Stdio::null())
-                .status()?;
-            let wall = t.elapsed().as_secs_f64();
-            let f = factors(&dir.join(format!("{name}.dat")))
-                .into_iter()
-                .map(|x| x * scale)
-                .collect();
-            Ok((wall, f, status.success()))
-        };
-        let (wall_a, fa, ok_a) = run(0.01)?;
-        let Some(&l1) = fa.first() else {
+        let ((wall_a, _, ok_a), pass_b) =
+            ccx::two_pass(&dir, name, |scale| deck(&m, n_arc, n_len, quads, scale))?;
+        let Some((wall_b, fb, ok_b)) = pass_b else {
             println!(
                 "| CalculiX 2.20 (pass A failed) | {elem} | {} | {wall_a:.2} | [] |",
                 m.nodes.len()
             );
             continue;
         };
-        let (wall_b, fb, ok_b) = run(l1 / 2.0)?;
         println!(
             "| CalculiX 2.20 ({}) | {elem} | {} | {wall_b:.2} (A+B {:.2}) | {fb:?} |",
             if ok_a && ok_b { "ok" } else { "FAILED" },

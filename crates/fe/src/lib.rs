@@ -41,6 +41,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod assembly;
+pub mod ccx;
 pub mod element;
 pub mod error;
 mod factor;
@@ -49,6 +50,7 @@ pub mod mesh_json;
 pub mod model;
 pub mod oracle;
 mod solver;
+pub mod summary;
 
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};

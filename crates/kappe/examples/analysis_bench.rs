@@ -8,7 +8,80 @@ use std::time::Instant;
 
 use kappe::analysis::{AnalysisOptions, analyze, state_buckling, state_material};
 
+/// `-- profile FILE.toml [STATES]`: per-state split of the buckling check of a design file
+/// (build state, force pass, graded reduction, shell, FE phases, Lanczos steps).
+fn profile(file: &str, states: &[usize]) -> Result<(), Box<dyn std::error::Error>> {
+    let design = kappe::Design::from_toml_str(&std::fs::read_to_string(file)?)?;
+    let t = Instant::now();
+    let cap = kappe::design_cap(&design, &|_| {})?;
+    println!(
+        "{file}: {} states, design_cap {:.2} s",
+        cap.states.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let o = design.analysis.clone();
+    let phi = design.print.start_arch_fraction;
+    let total = cap.states.len();
+    let picks: Vec<usize> = if states.is_empty() {
+        (1..=4).map(|k| k * (total - 1) / 4).collect()
+    } else {
+        states.to_vec()
+    };
+    println!(
+        "| state | build | stresses | graded | shell | nodes | DOFs | nnz(L) | symbolic | assembly | factor | K_G | Lanczos (steps) | BLF |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for top in picks {
+        let t = Instant::now();
+        let state = kappe::states::build_state(&cap.sections, &cap.frame, phi, top)?;
+        let t_build = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let _ = kappe::analysis::element_stresses(&state, cap.areas())?;
+        let t_stress = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let reduced = match &o.grading {
+            Some(g) => kappe::window::graded_state(&state, g),
+            None => state.clone(),
+        };
+        let t_graded = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mat = state_material(&cap, &o, top);
+        let Ok(shell) = kappe::shell::state_shell(&reduced, &mat, o.row_stride) else {
+            continue;
+        };
+        let t_shell = t.elapsed().as_secs_f64();
+        let fe_opts = kappe_fe::BucklingOptions {
+            modes: o.modes,
+            tolerance: 1e-8,
+            sturm_check: false,
+            ..Default::default()
+        };
+        let r = kappe_fe::buckling(&shell.model, &fe_opts)?;
+        let s = &r.stats;
+        println!(
+            "| {top} | {t_build:.3} | {t_stress:.3} | {t_graded:.3} | {t_shell:.3} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.4} |",
+            shell.model.nodes.len(),
+            s.n_free_dofs,
+            s.nnz_l,
+            s.t_symbolic,
+            s.t_assembly,
+            s.t_factor,
+            s.t_geometric,
+            s.t_eigen,
+            s.operator_applications,
+            r.factors.first().copied().unwrap_or(f64::NAN)
+        );
+    }
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().is_some_and(|a| a == "profile") {
+        let file = args.get(1).ok_or("profile FILE.toml [STATES]")?;
+        let states: Vec<usize> = args.iter().skip(2).filter_map(|a| a.parse().ok()).collect();
+        return profile(file, &states);
+    }
     let stride: usize = std::env::args()
         .nth(1)
         .map(|s| s.parse())

@@ -8,18 +8,15 @@
 //! `cargo run --release -p kappe --example ccx_state -- STATE [STATE …]`
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::Path;
-use std::process::Command;
-use std::time::Instant;
 
 use kappe::analysis::{AnalysisOptions, state_material};
 use kappe::shell::state_shell;
 use kappe::states::build_state;
-use kappe_fe::{BucklingOptions, ElementKind, ShellModel};
+use kappe_fe::{BucklingOptions, ElementKind, ShellModel, ccx};
 
 fn deck(m: &ShellModel, scale: f64) -> String {
-    let mut s = String::from("*HEADING\nstate\n*NODE\n");
+    let mut s = String::from("*HEADING\nstate\n");
     let mut nodes = m.nodes.clone();
     let fixed = m.fixed_mask();
     let mut pinned: Vec<bool> = fixed.iter().map(|f| f[0]).collect();
@@ -43,73 +40,29 @@ fn deck(m: &ShellModel, scale: f64) -> String {
         }
         elems.push(e);
     }
-    for (i, p) in nodes.iter().enumerate() {
-        let _ = writeln!(s, "{}, {:.12e}, {:.12e}, {:.12e}", i + 1, p[0], p[1], p[2]);
-    }
-    s.push_str("*ELEMENT, TYPE=S6, ELSET=EALL\n");
-    for (k, e) in elems.iter().enumerate() {
-        let ids: Vec<String> = e.iter().map(|n| (n + 1).to_string()).collect();
-        let _ = writeln!(s, "{}, {}", k + 1, ids.join(", "));
-    }
-    s.push_str("*NSET, NSET=SUP\n");
-    let sup: Vec<String> = (0..nodes.len())
-        .filter(|&n| pinned[n])
-        .map(|n| (n + 1).to_string())
-        .collect();
-    for c in sup.chunks(10) {
-        let _ = writeln!(s, "{}", c.join(", "));
-    }
-    let mat = m.materials[0];
-    let g = 9.81;
-    let _ = write!(
-        s,
-        "*BOUNDARY\nSUP, 1, 3\n*MATERIAL, NAME=M\n*ELASTIC\n{:e}, {}\n*DENSITY\n{:e}\n\
-         *SHELL SECTION, ELSET=EALL, MATERIAL=M\n{}\n*STEP\n*BUCKLE\n2, 1e-6\n\
-         *DLOAD\nEALL, GRAV, {:.8e}, 0., 0., -1.\n*END STEP\n",
-        mat.youngs_modulus,
-        mat.poisson_ratio,
-        mat.unit_weight / g,
-        m.thickness[0],
-        g * scale
+    ccx::write_nodes(&mut s, &nodes);
+    ccx::write_elements(
+        &mut s,
+        "S6",
+        elems.iter().map(|e| e.iter().map(|n| n + 1).collect()),
     );
+    ccx::write_supports(
+        &mut s,
+        (0..nodes.len()).filter(|&n| pinned[n]).map(|n| n + 1),
+    );
+    let step = ccx::BuckleStep::of(m, 2);
+    ccx::write_buckle_step(&mut s, &step, scale);
     s
 }
 
-fn factors(dat: &Path) -> Vec<f64> {
-    let text = std::fs::read_to_string(dat).unwrap_or_default();
-    let mut out = Vec::new();
-    let mut on = false;
-    for line in text.lines() {
-        if line.contains("B U C K L I N G") {
-            on = true;
-            continue;
-        }
-        if on {
-            let w: Vec<&str> = line.split_whitespace().collect();
-            if let [a, b] = w.as_slice()
-                && let (Ok(_), Ok(f)) = (a.parse::<usize>(), b.parse::<f64>())
-            {
-                out.push(f);
-            }
-        }
-    }
-    out
-}
-
-fn ccx(dir: &Path, m: &ShellModel, scale: f64) -> Result<(f64, f64), Box<dyn std::error::Error>> {
-    std::fs::write(dir.join("state.inp"), deck(m, scale))?;
-    let t = Instant::now();
-    Command::new("ccx")
-        .arg("state")
-        .current_dir(dir)
-        .env("OMP_NUM_THREADS", "2")
-        .stdout(std::process::Stdio::null())
-        .status()?;
-    let f = factors(&dir.join("state.dat"));
-    Ok((
-        f.first().map_or(f64::NAN, |x| x * scale),
-        t.elapsed().as_secs_f64(),
-    ))
+/// ccx's λ₁ of the state with the load scaled by `scale`, and its wall time.
+fn ccx_run(
+    dir: &Path,
+    m: &ShellModel,
+    scale: f64,
+) -> Result<(f64, f64), Box<dyn std::error::Error>> {
+    let (wall, f, _) = ccx::run(dir, "state", &deck(m, scale), scale)?;
+    Ok((f.first().copied().unwrap_or(f64::NAN), wall))
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -148,8 +101,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )?
             .factors[0];
         }
-        let (a, _) = ccx(dir, &shell.model, l[1] / 2.0)?;
-        let (b, secs) = ccx(dir, &shell.model, a / 2.0)?;
+        let (a, _) = ccx_run(dir, &shell.model, l[1] / 2.0)?;
+        let (b, secs) = ccx_run(dir, &shell.model, a / 2.0)?;
         println!(
             "| {top} | {} | {:.4} | {:.4} | {b:.4} | {:+.2} % | {:+.2} % | {secs:.1} |",
             shell.model.nodes.len(),

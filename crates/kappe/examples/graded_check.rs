@@ -1,62 +1,57 @@
 //! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::window`).
 //!
-//! `cargo run --release -p kappe --example graded_check -- LENGTH FINE:MAX_STRIDE ...`
-//! (e.g. `0.6 16:8 16:32`): per grading, the largest relative BLF difference over every state,
-//! the governing state and BLF, and the FE wall time, against the full mesh. `KAPPE_END=end_wall`
-//! for an end-wall cap.
+//! `cargo run --release -p kappe --example graded_check -- LENGTH [FINE:MAX_STRIDE[:ZONE_ROWS[:TRANSVERSE]]] ...`
+//! (e.g. `1.2 32:32:8:4`; no grading given: the default one): per grading, the largest relative
+//! BLF difference over the checked states, the governing state and BLF, and the buckling wall
+//! time (`kappe::analysis::analyze`, so the graded runs are warm-started as in `kappe design`),
+//! against the full mesh. Environment: `KAPPE_END=end_wall` for an end-wall cap,
+//! `KAPPE_STATES=every:N` to check every N-th state only (long caps), `KAPPE_NO_FULL=1` to time
+//! the gradings alone.
 
-use std::time::Instant;
-
-use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
-use kappe::states::build_state;
-use kappe::window::{Grading, graded_state};
+use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
+use kappe::window::Grading;
 use kappe::{Design, design_cap};
-use rayon::prelude::*;
 
-fn main() {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let length: f64 = args.first().and_then(|a| a.parse().ok()).unwrap_or(0.6);
-    let gradings: Vec<Grading> = args
+    let mut gradings: Vec<Grading> = args
         .iter()
         .skip(1)
         .filter_map(|a| {
-            let (f, s) = a.split_once(':')?;
+            let v: Vec<usize> = a.split(':').filter_map(|x| x.parse().ok()).collect();
+            let d = Grading::default();
             Some(Grading {
-                fine: f.parse().ok()?,
-                max_stride: s.parse().ok()?,
+                fine: *v.first()?,
+                max_stride: *v.get(1)?,
+                zone_rows: v.get(2).copied().unwrap_or(d.zone_rows),
+                transverse: v.get(3).copied().unwrap_or(d.transverse),
             })
         })
         .collect();
+    if gradings.is_empty() {
+        gradings.push(Grading::default());
+    }
     let mut d = Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "end_wall") {
         d.cap.end = kappe::ends::EndKind::EndWall;
     }
-    let cap = design_cap(&d, &|_| {}).expect("design");
-    let opts = AnalysisOptions::default();
+    let states: StateSelection = std::env::var("KAPPE_STATES")
+        .ok()
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or_default();
+    let cap = design_cap(&d, &|_| {})?;
     let total = cap.states.len();
-    let blf = |g: Option<&Grading>| -> (Vec<Option<f64>>, f64) {
-        let t0 = Instant::now();
-        let v = (0..total)
-            .into_par_iter()
-            .rev()
-            .map(|top| {
-                let st = build_state(&cap.sections, &cap.frame, 0.0, top).unwrap();
-                let st = match g {
-                    Some(g) => graded_state(&st, g),
-                    None => st,
-                };
-                let m = state_material(&cap, &opts, top);
-                state_buckling(&st, &m, &opts)
-                    .unwrap()
-                    .factors
-                    .first()
-                    .copied()
-            })
-            .collect::<Vec<_>>();
-        let mut v = v;
-        v.reverse();
-        (v, t0.elapsed().as_secs_f64())
+    let run = |grading: Option<Grading>| -> Result<(Vec<Option<f64>>, f64), String> {
+        let o = AnalysisOptions {
+            states,
+            grading,
+            ..AnalysisOptions::default()
+        };
+        let a = analyze(&cap, &o, &|_| {}).map_err(|e| e.to_string())?;
+        Ok((a.states.iter().map(|s| s.blf).collect(), a.timings.fe))
     };
     let argmin = |v: &[Option<f64>]| {
         v.iter()
@@ -67,17 +62,19 @@ fn main() {
     let (full, t_full) = if std::env::var("KAPPE_NO_FULL").is_ok() {
         (vec![None; total], 0.0)
     } else {
-        blf(None)
+        run(None)?
     };
     println!(
-        "length {length} m, end {:?}, {total} states; full mesh: FE {t_full:.2} s, governing {:?}",
+        "length {length} m, end {:?}, {total} states, states {states}; full mesh: FE {t_full:.2} s, governing {:?}",
         d.cap.end,
         argmin(&full)
     );
-    println!("| fine:max_stride | max rel BLF diff | at state | governing (state, BLF) | FE s |");
+    println!(
+        "| fine:max_stride:zone_rows:transverse | max rel BLF diff | at state | governing (state, BLF) | FE s |"
+    );
     println!("|---|---|---|---|---|");
     for g in &gradings {
-        let (v, t) = blf(Some(g));
+        let (v, t) = run(Some(*g))?;
         let mut worst = (0.0_f64, 0usize);
         for (i, (a, b)) in full.iter().zip(&v).enumerate() {
             if let (Some(a), Some(b)) = (a, b) {
@@ -88,12 +85,15 @@ fn main() {
             }
         }
         println!(
-            "| {}:{} | {:.3e} | {} | {:?} | {t:.2} |",
+            "| {}:{}:{}:{} | {:.3e} | {} | {:?} | {t:.2} |",
             g.fine,
             g.max_stride,
+            g.zone_rows,
+            g.transverse,
             worst.0,
             worst.1,
             argmin(&v)
         );
     }
+    Ok(())
 }

@@ -5,6 +5,10 @@
 
 use std::time::Instant;
 
+#[path = "common/measure.rs"]
+mod measure;
+use measure::{cpu_seconds, load_average};
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cap = kappe::design_cap(&kappe::Design::default(), &|_| {})?;
     let (setup, options) = kappe::robot_plan::robot_inputs(&cap);
@@ -14,6 +18,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::fs::write(&out, serde_json::to_string(&v)?)?;
     }
     // Planning (ladder, stations) + timing + the independent check, all inside plan_print.
+    let load = load_average();
+    let cpu0 = cpu_seconds();
     let t = Instant::now();
     let plan = kappe_robot::plan_print(&layers, &setup, &options)?;
     let t_plan = t.elapsed().as_secs_f64();
@@ -28,6 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let t_lint = t.elapsed().as_secs_f64();
+    let cpu = cpu_seconds().zip(cpu0).map(|(b, a)| b - a);
     let t = Instant::now();
     let meshes = kappe_robot::meshes::verify_meshes(&plan, 1)?;
     let t_mesh = t.elapsed().as_secs_f64();
@@ -45,12 +52,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| write the programs | {t_prog:.3} |");
     println!("| lint every program | {t_lint:.3} |");
     println!(
-        "| **planning + timing + linting** | **{:.3}** |",
-        t_plan + t_prog + t_lint
+        "| **planning + timing + linting** | **{:.3}** wall, {} CPU (load average {load} before) |",
+        t_plan + t_prog + t_lint,
+        cpu.map_or_else(|| "?".to_string(), |c| format!("{c:.2} s"))
     );
     println!(
         "| mesh verification ({} waypoints) | {t_mesh:.3} |",
         meshes.waypoints_checked
     );
+    if let Some(c) = &plan.certified {
+        println!(
+            "capsules, certified along the motion: environment ≥ {:.4} m (approaches and retracts ≥ {:.4} m), self ≥ {:.4} m ({} configurations)",
+            c.clearance, c.approach_clearance, c.self_distance, c.configurations
+        );
+    }
+    if let Some(a) = &meshes.along_motion {
+        println!(
+            "meshes at waypoints: environment {:.4} m, self {:.4} m; certified along the motion: environment ≥ {:.4} m, nozzle ≥ {:.4} m, self ≥ {:.4} m",
+            meshes.meshes.environment.distance,
+            meshes.meshes.self_distance.distance,
+            a.environment.distance,
+            a.nozzle.distance,
+            a.self_distance.distance
+        );
+    }
+    let sizes: Vec<usize> = plan.parts.iter().map(|p| p.targets).collect();
+    println!("program files (targets): {sizes:?}");
     Ok(())
 }

@@ -1,9 +1,63 @@
 //! Wall-clock split of the whole default design in release:
 //! `cargo run --release -p kappe --example timings`.
+//!
+//! `-- ceiling [FILE]`: a ceiling end to end as `kappe design` runs it (every bay designed,
+//! analysed, both halves planned, the base-pose tolerance checked), bay by bay; without FILE the
+//! full-size example of `kappe init --kind ceiling` (three 1.2 m bays, 3 m between end walls).
 
 use std::time::Instant;
 
+/// A ceiling end to end, bay by bay (issue 15: the full-size example is a benchmark).
+fn ceiling(file: Option<&String>) -> Result<(), Box<dyn std::error::Error>> {
+    let text = match file {
+        Some(f) => std::fs::read_to_string(f)?,
+        None => kappe::ceiling::EXAMPLE_TOML.to_string(),
+    };
+    let c = kappe::ceiling::CeilingDesign::from_toml_str(&text)?;
+    let designs = c.bay_designs()?;
+    let first = designs.first().ok_or("no bay")?;
+    let options = kappe::Options::of(first);
+    println!(
+        "| bay | span m | states per half | analysis s | robot + tolerance s | total s | ok |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    let t_all = Instant::now();
+    let mut bays = Vec::new();
+    for i in 0..designs.len() {
+        let t = Instant::now();
+        let bay =
+            kappe::ceiling::run_bay(&c, i, &options, &|_| std::ops::ControlFlow::Continue(()))?;
+        let total = t.elapsed().as_secs_f64();
+        let fe = bay
+            .outcome
+            .analysis
+            .as_ref()
+            .map_or(0.0, |a| a.timings.total);
+        println!(
+            "| {} | {:.3} | {} | {fe:.1} | {:.1} | {total:.1} | {} |",
+            i + 1,
+            bay.design.cap.span,
+            bay.outcome.cap.states.len(),
+            total - fe,
+            bay.outcome.ok
+        );
+        bays.push(bay);
+    }
+    let out = kappe::ceiling::CeilingOutcome::from_bays(&c, bays);
+    println!(
+        "ceiling: {} bays, {:.1} s, {}",
+        out.bays.len(),
+        t_all.elapsed().as_secs_f64(),
+        if out.ok { "passes" } else { "FAILS" }
+    );
+    Ok(())
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().is_some_and(|a| a == "ceiling") {
+        return ceiling(args.get(1));
+    }
     let design = kappe::Design::default();
     let t = Instant::now();
     let cap = kappe::design_cap(&design, &|_| {})?;
@@ -32,6 +86,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "| robot plan ({} stations, verified) | {t_plan:.3} |",
         plan.stations.len()
+    );
+    let t = Instant::now();
+    let tol = kappe_robot::tolerance::check_base_tolerance(
+        &plan,
+        &kappe_robot::tolerance::BaseTolerance::default(),
+    );
+    println!(
+        "| base-pose tolerance ±{} m, ±{}° ({} poses/station, {} waypoints; min clearance {:.4} m; {}) | {:.3} |",
+        tol.tolerance.position,
+        tol.tolerance.yaw_deg,
+        tol.poses_per_station,
+        tol.waypoints_checked,
+        tol.min_clearance,
+        if tol.ok() {
+            "ok".to_string()
+        } else {
+            tol.problems.join("; ")
+        },
+        t.elapsed().as_secs_f64()
     );
     println!(
         "verdict: {}",

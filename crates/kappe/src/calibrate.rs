@@ -342,3 +342,157 @@ pub fn derive(evidence: Vec<Evidence>) -> Calibration {
         explanation,
     }
 }
+
+/// A file that a calibration file names could not be read or is invalid (each with its cause
+/// as the error's source, so the CLI prints the same chain as before).
+#[derive(Debug, thiserror::Error)]
+pub enum SourceError {
+    /// An inline prototype design does not validate.
+    #[error("prototype {name:?}: invalid design")]
+    InlineDesign {
+        /// Prototype.
+        name: String,
+        /// Why.
+        #[source]
+        source: DesignError,
+    },
+    /// A prototype's design file cannot be read.
+    #[error("prototype {name:?}: cannot read {}", path.display())]
+    Read {
+        /// Prototype.
+        name: String,
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A prototype's design file is invalid.
+    #[error("prototype {name:?}: invalid design file {}", path.display())]
+    Design {
+        /// Prototype.
+        name: String,
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: DesignError,
+    },
+    /// The buildability spec of a print calibration cannot be read.
+    #[error("cannot read the buildability spec {}", path.display())]
+    ReadSpec {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The buildability spec of a print calibration is invalid.
+    #[error("invalid buildability spec {}", path.display())]
+    Spec {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: DesignError,
+    },
+}
+
+/// Whether a calibration file's text is the buildability-prints form (a top-level
+/// `buildability` key, [`crate::print_calibration`]) rather than prototypes.
+pub fn is_prints_file(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("buildability"))
+}
+
+/// The designs of a prototype file: inline ones validated, paths read relative to `base` (the
+/// prototype file's directory).
+///
+/// # Errors
+/// The first prototype whose design cannot be read or is invalid.
+pub fn resolve_prototypes(
+    file: &PrototypeFile,
+    base: &std::path::Path,
+) -> Result<Vec<Resolved>, SourceError> {
+    file.prototypes
+        .iter()
+        .map(|p| {
+            let design = match &p.design {
+                DesignSource::Inline(d) => {
+                    d.validate().map_err(|source| SourceError::InlineDesign {
+                        name: p.name.clone(),
+                        source,
+                    })?;
+                    (**d).clone()
+                }
+                DesignSource::Path(rel) => {
+                    let path = base.join(rel);
+                    let text =
+                        std::fs::read_to_string(&path).map_err(|source| SourceError::Read {
+                            name: p.name.clone(),
+                            path: path.clone(),
+                            source,
+                        })?;
+                    Design::from_toml_str(&text).map_err(|source| SourceError::Design {
+                        name: p.name.clone(),
+                        path,
+                        source,
+                    })?
+                }
+            };
+            Ok(Resolved {
+                prototype: p.clone(),
+                design,
+            })
+        })
+        .collect()
+}
+
+/// The calibration as the JSON document `kappe calibrate --json/--out` writes.
+pub fn document(file: &PrototypeFile, cal: &Calibration) -> serde_json::Value {
+    serde_json::json!({
+        "format": "kappe.calibration",
+        "version": 1,
+        "analysis": file.analysis,
+        "calibration": cal,
+    })
+}
+
+/// The calibration as the text report `kappe calibrate` prints (one line per prototype, the
+/// threshold, the explanation), newline-terminated.
+pub fn text_report(cal: &Calibration) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "Calibration from {} prototypes", cal.evidence.len());
+    let _ = writeln!(
+        s,
+        "  {:<16} {:>7} {:>8} {:>14} {:>14}",
+        "prototype", "outcome", "E [MPa]", "min BLF stood", "BLF at failure"
+    );
+    let f = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
+    for e in &cal.evidence {
+        let _ = writeln!(
+            s,
+            "  {:<16} {:>7} {:>8.3} {:>14} {:>14}",
+            e.name,
+            match e.outcome {
+                Outcome::Stood => "stood",
+                Outcome::Failed => "failed",
+            },
+            e.youngs_modulus / 1e6,
+            f(e.min_blf_survived),
+            f(e.blf_at_failure)
+        );
+    }
+    let _ = writeln!(s, "  BLF_min = {:.4}", cal.blf_min);
+    if let Some(ee) = cal.effective_modulus {
+        let _ = writeln!(
+            s,
+            "  (equivalently E_eff = {:.3} MPa with BLF_min = 1)",
+            ee / 1e6
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", cal.explanation);
+    s
+}

@@ -40,6 +40,7 @@ use crate::analysis::AnalysisOptions;
 use crate::ends::EndKind;
 use crate::error::DesignError;
 use crate::evaluate::{Options, Outcome, Progress};
+use crate::output::{OutputError, OutputFile, plan_files};
 use crate::spec::{ConstraintSpec, Design, MaterialSpec, PrintSpec, RobotSpec};
 
 /// The commented example ceiling that `kappe init --kind ceiling` writes: three bays of 1.2 m
@@ -243,6 +244,8 @@ pub struct BayOutcome {
     pub outcome: Outcome,
     /// The robot plan of the mirrored second half (`both_walls` with the robot on).
     pub mirror_plan: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The base-pose tolerance check of the mirrored half's plan (`[robot.tolerance]`).
+    pub mirror_tolerance: Option<kappe_robot::tolerance::ToleranceReport>,
 }
 
 /// The whole ceiling.
@@ -258,42 +261,90 @@ pub struct CeilingOutcome {
 
 /// Design, analyse and plan every bay of `ceiling` (bays one after another; each bay's states
 /// run in parallel). `on_progress(bay, progress)` hears every bay's progress.
+///
+/// The same as [`run_bay`] for every bay, then [`CeilingOutcome::from_bays`]; a cluster runs
+/// one [`run_bay`] per task instead (the Python package's `kappe.ceiling(..., client=...)`).
+///
+/// # Errors
+/// An invalid bay, or what [`crate::run`] returns for one.
 pub fn run_ceiling(
     ceiling: &CeilingDesign,
     options: &Options,
     on_progress: &(dyn Fn(usize, Progress) -> ControlFlow<()> + Sync),
 ) -> Result<CeilingOutcome, DesignError> {
+    let n = ceiling.bay_designs()?.len();
+    let bays = (0..n)
+        .map(|i| run_bay(ceiling, i, options, &|p| on_progress(i, p)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(CeilingOutcome::from_bays(ceiling, bays))
+}
+
+/// Design, analyse and plan bay `index` (0-based, across x) of `ceiling`, with the mirrored
+/// plan of its second half for `both_walls`. Independent of the other bays.
+///
+/// # Errors
+/// `index` beyond the bays ([`DesignError::Invalid`]), an invalid bay, or what [`crate::run`]
+/// returns for it.
+pub fn run_bay(
+    ceiling: &CeilingDesign,
+    index: usize,
+    options: &Options,
+    on_progress: crate::evaluate::OnProgress<'_>,
+) -> Result<BayOutcome, DesignError> {
     let designs = ceiling.bay_designs()?;
+    let n = designs.len();
     let beam = ceiling.robot.beams.width;
-    let mut x = 0.0;
-    let mut bays = Vec::with_capacity(designs.len());
-    for (i, d) in designs.into_iter().enumerate() {
-        let x_centre = x + 0.5 * d.cap.span;
-        x += d.cap.span + beam;
-        let outcome = crate::evaluate::run(&d, options, &|p| on_progress(i, p))?;
-        let halves = if ceiling.ceiling.ends == BayEnds::BothWalls {
-            2
-        } else {
-            1
-        };
-        let mirror_plan =
-            (halves == 2 && options.robot && d.robot.enabled).then(|| plan_mirrored(&outcome.cap));
-        bays.push(BayOutcome {
-            design: d,
-            x_centre,
-            halves,
-            outcome,
-            mirror_plan,
+    // The bays stand side by side across x, a beam between neighbours.
+    let x_start: f64 = designs.iter().take(index).map(|d| d.cap.span + beam).sum();
+    let Some(d) = designs.into_iter().nth(index) else {
+        return Err(DesignError::Invalid {
+            field: "bay",
+            value: index.to_string(),
+            allowed: format!("a bay index 0..{n}"),
         });
-    }
-    let ok = bays
-        .iter()
-        .all(|b| b.outcome.ok && b.mirror_plan.as_ref().is_none_or(|p| p.is_ok()));
-    Ok(CeilingOutcome {
-        design: ceiling.clone(),
-        bays,
-        ok,
+    };
+    let x_centre = x_start + 0.5 * d.cap.span;
+    let outcome = crate::evaluate::run(&d, options, on_progress)?;
+    let halves = if ceiling.ceiling.ends == BayEnds::BothWalls {
+        2
+    } else {
+        1
+    };
+    let mirror_plan =
+        (halves == 2 && options.robot && d.robot.enabled).then(|| plan_mirrored(&outcome.cap));
+    let tol = &d.robot.tolerance;
+    let mirror_tolerance = match &mirror_plan {
+        Some(Ok(plan)) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
+            plan,
+            &tol.base_tolerance(),
+        )),
+        _ => None,
+    };
+    Ok(BayOutcome {
+        design: d,
+        x_centre,
+        halves,
+        outcome,
+        mirror_plan,
+        mirror_tolerance,
     })
+}
+
+impl CeilingOutcome {
+    /// The ceiling of `bays` (in order, as [`run_bay`] returns them).
+    pub fn from_bays(ceiling: &CeilingDesign, bays: Vec<BayOutcome>) -> Self {
+        let ok = bays.iter().all(|b| {
+            b.outcome.ok
+                && b.mirror_plan.as_ref().is_none_or(|p| p.is_ok())
+                && !(b.design.robot.tolerance.verdict
+                    && b.mirror_tolerance.as_ref().is_some_and(|t| !t.ok()))
+        });
+        CeilingOutcome {
+            design: ceiling.clone(),
+            bays,
+            ok,
+        }
+    }
 }
 
 /// Plan the mirror image (y → −y) of a cap's print: the second half of a `both_walls` bay in its
@@ -403,6 +454,23 @@ impl BayOutcome {
             .map(|s| json!(s))
             .collect();
         let robot_time: f64 = plans.iter().map(|p| p.total_time).sum();
+        // The base-pose tolerance of each planned half (issue 15, `[robot.tolerance]`).
+        let tolerance: Vec<Value> = self
+            .outcome
+            .base_tolerance
+            .iter()
+            .chain(self.mirror_tolerance.iter())
+            .map(|t| {
+                json!({
+                    "ok": t.ok(),
+                    "min_clearance_m": t.min_clearance,
+                    "problems": t.problems.len(),
+                    "first_problem": t.problems.first(),
+                })
+            })
+            .collect();
+        let tolerance_fails = self.design.robot.tolerance.verdict
+            && tolerance.iter().any(|t| t["ok"] == json!(false));
         let stations: usize = plans.iter().map(|p| p.stations.len()).sum();
         let relocation: f64 = schedules
             .iter()
@@ -434,6 +502,7 @@ impl BayOutcome {
                 "relocation_time_s": relocation,
                 "schedules": schedules,
                 "failures": failures,
+                "base_tolerance": tolerance,
             },
             "wall_load": crate::ends::cap_wall_load(cap).map(|w| json!({
                 "per_wall_total_n": w.load.total,
@@ -444,52 +513,151 @@ impl BayOutcome {
             "closure_gap_m": (self.halves == 2).then(|| 2.0 * crate::ends::far_end_gap(self.design.cap.rise, self.design.tilt())),
             "worst_constraint": self.worst_constraint(),
             "min_blf": self.outcome.min_blf(),
-            "ok": self.outcome.ok && failures.is_empty(),
+            "ok": self.outcome.ok && failures.is_empty() && !tolerance_fails,
         })
     }
 }
 
+/// `ceiling.json` from the bays' rows ([`BayOutcome::summary`], in order): the room, every
+/// bay's row and the totals. The ceiling passes when every bay does. A cluster that ran one
+/// [`run_bay`] per task assembles the room with this.
+pub fn ceiling_summary(design: &CeilingDesign, bays: Vec<Value>) -> Value {
+    let sum = |k: &str| bays.iter().filter_map(|b| b[k].as_f64()).sum::<f64>();
+    let robot_sum = |k: &str| {
+        bays.iter()
+            .filter_map(|b| b["robot"][k].as_f64())
+            .sum::<f64>()
+    };
+    let ok = bays.iter().all(|b| b["ok"].as_bool() == Some(true));
+    json!({
+        "format": "kappe.ceiling.summary",
+        "version": 1,
+        "name": design.name,
+        "length_m": design.ceiling.length,
+        "ends": design.ceiling.ends,
+        "total": {
+            "volume_m3": sum("volume_m3"),
+            "mass_kg": sum("mass_kg"),
+            "print_time_s": sum("print_time_s"),
+            "robot_time_s": robot_sum("time_s"),
+            "relocation_time_s": robot_sum("relocation_time_s"),
+        },
+        "bays": bays,
+        "ok": ok,
+    })
+}
+
 impl CeilingOutcome {
-    /// `ceiling.json`: the room, every bay's row and the totals.
+    /// `ceiling.json`: the room, every bay's row and the totals ([`ceiling_summary`]).
     pub fn summary(&self) -> Value {
-        let bays: Vec<Value> = self.bays.iter().map(BayOutcome::summary).collect();
-        let sum = |k: &str| bays.iter().filter_map(|b| b[k].as_f64()).sum::<f64>();
-        let robot_sum = |k: &str| {
-            bays.iter()
-                .filter_map(|b| b["robot"][k].as_f64())
-                .sum::<f64>()
-        };
-        json!({
-            "format": "kappe.ceiling.summary",
-            "version": 1,
-            "name": self.design.name,
-            "length_m": self.design.ceiling.length,
-            "ends": self.design.ceiling.ends,
-            "bays": bays,
-            "total": {
-                "volume_m3": sum("volume_m3"),
-                "mass_kg": sum("mass_kg"),
-                "print_time_s": sum("print_time_s"),
-                "robot_time_s": robot_sum("time_s"),
-                "relocation_time_s": robot_sum("relocation_time_s"),
-            },
-            "ok": self.ok,
-        })
+        ceiling_summary(
+            &self.design,
+            self.bays.iter().map(BayOutcome::summary).collect(),
+        )
     }
 
-    /// The room's report: one self-contained page with the summary table, linking each bay's
-    /// own report at `bay_N/report.html` (written next to it by the caller).
+    /// Every file of the ceiling's output directory: `ceiling.json`, `index.html` and every
+    /// bay's [`BayOutcome::files`] under `bay_N/`.
+    ///
+    /// # Errors
+    /// As [`BayOutcome::files`].
+    pub fn files(&self, allow_fail: bool) -> Result<Vec<OutputFile>, OutputError> {
+        let summary = self.summary();
+        let text = serde_json::to_vec_pretty(&summary)
+            .map_err(|e| OutputError::Produce(format!("cannot write ceiling.json: {e}")))?;
+        let mut out = vec![
+            OutputFile::new("ceiling.json", text),
+            OutputFile::new("index.html", index_html(&self.design, &summary)),
+        ];
+        for (i, bay) in self.bays.iter().enumerate() {
+            let dir = format!("bay_{}", i + 1);
+            out.extend(bay.files(allow_fail)?.into_iter().map(|f| f.under(&dir)));
+        }
+        Ok(out)
+    }
+
+    /// The lines `kappe design ROOM.toml` prints: the bays and their verdicts; `out` is the
+    /// output directory it names.
+    pub fn table(&self, out: &std::path::Path) -> String {
+        let mut t = format!(
+            "Kappe ceiling: {} bay(s); wrote {}/{{ceiling.json, index.html, bay_N/}}\n",
+            self.bays.len(),
+            out.display()
+        );
+        for (i, bay) in self.bays.iter().enumerate() {
+            t.push_str(&format!(
+                "  bay {}: span {:.3} m, {} half/halves, {}\n",
+                i + 1,
+                bay.design.cap.span,
+                bay.halves,
+                if bay.outcome.ok { "passes" } else { "FAILS" }
+            ));
+        }
+        t
+    }
+
+    /// One line per failing bay, starting with `level` (`error`, or `warning` when failing is
+    /// allowed).
+    pub fn failure_lines(&self, level: &str) -> Vec<String> {
+        (1..)
+            .zip(&self.bays)
+            .filter(|(_, b)| !b.outcome.ok)
+            .map(|(n, _)| format!("{level}: bay {n} fails its checks (see bay_{n}/report.html)"))
+            .collect()
+    }
+
+    /// The room's report ([`index_html`] of [`CeilingOutcome::summary`]).
     pub fn index_html(&self) -> String {
-        let s = self.summary();
-        let esc = |t: &str| {
-            t.replace('&', "&amp;")
-                .replace('<', "&lt;")
-                .replace('>', "&gt;")
-        };
-        let mut rows = String::new();
-        for (i, b) in s["bays"].as_array().into_iter().flatten().enumerate() {
-            let w = &b["worst_constraint"];
-            rows.push_str(&format!(
+        index_html(&self.design, &self.summary())
+    }
+}
+
+impl BayOutcome {
+    /// The files of one bay's directory: `summary.json`, `report.html`, `path.csv`, and when
+    /// the bay passes (or `allow_fail`) its robot plan's files ([`crate::output::plan_files`])
+    /// and those of the mirrored second half under `mirror/`.
+    ///
+    /// # Errors
+    /// [`OutputError::Produce`] when a file cannot be produced (a program failing the URScript
+    /// check, a report that does not render).
+    pub fn files(&self, allow_fail: bool) -> Result<Vec<OutputFile>, OutputError> {
+        let eval = &self.outcome;
+        let summary = serde_json::to_vec_pretty(&eval.summary())
+            .map_err(|e| OutputError::Produce(format!("cannot write summary.json: {e}")))?;
+        let report = eval
+            .report_html()
+            .map_err(|e| OutputError::Produce(format!("cannot write report.html: {e}")))?;
+        let mut out = vec![
+            OutputFile::new("summary.json", summary),
+            OutputFile::new("report.html", report),
+            OutputFile::new("path.csv", eval.cap.path.to_csv()),
+        ];
+        if eval.ok || allow_fail {
+            if let Some(Ok(plan)) = &eval.robot {
+                out.extend(plan_files(plan, "program_part", true)?);
+            }
+            if let Some(Ok(plan)) = &self.mirror_plan {
+                let files = plan_files(plan, "program_part", true)?;
+                out.extend(files.into_iter().map(|f| f.under("mirror")));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The room's report: one self-contained page with the summary table of `summary`
+/// ([`ceiling_summary`]), linking each bay's own report at `bay_N/report.html`.
+pub fn index_html(design: &CeilingDesign, summary: &Value) -> String {
+    let s = summary;
+    let esc = |t: &str| {
+        t.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let mut rows = String::new();
+    for (i, b) in s["bays"].as_array().into_iter().flatten().enumerate() {
+        let w = &b["worst_constraint"];
+        rows.push_str(&format!(
                 "<tr><td><a href=\"bay_{n}/report.html\">{name}</a></td><td>{span:.3}</td><td>{halves}</td>\
                  <td>{mass:.1}</td><td>{vol:.4}</td><td>{pt:.0}</td><td>{rt:.0}</td><td>{st}</td>\
                  <td>{wc} ({ut}) {el}</td><td>{blf}</td><td class=\"{cls}\">{ok}</td></tr>\n",
@@ -513,10 +681,10 @@ impl CeilingOutcome {
                 cls = if b["ok"].as_bool() == Some(true) { "ok" } else { "fail" },
                 ok = if b["ok"].as_bool() == Some(true) { "pass" } else { "FAIL" },
             ));
-        }
-        let t = &s["total"];
-        format!(
-            "<!doctype html><html><head><meta charset=\"utf-8\"><title>{name}</title>\
+    }
+    let t = &s["total"];
+    format!(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>{name}</title>\
              <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}\
              td,th{{border:1px solid #ccc;padding:4px 8px;text-align:right}}td:first-child{{text-align:left}}\
              .ok{{color:#070}}.fail{{color:#b00;font-weight:bold}}</style></head><body>\
@@ -526,17 +694,20 @@ impl CeilingOutcome {
              <th>min BLF</th><th>verdict</th></tr>\n{rows}</table>\
              <p>Total: {mass:.1} kg, {vol:.4} m³, print {pt:.0} min, robot {rt:.0} min (relocations {rl:.0} min).</p>\
              <script type=\"application/json\" id=\"ceiling\">{json}</script></body></html>\n",
-            name = esc(self.design.name.as_str()),
-            nb = self.bays.len(),
-            len = self.design.ceiling.length,
-            ends = esc(&format!("{:?}", self.design.ceiling.ends)),
-            verdict = if self.ok { "pass" } else { "FAIL" },
-            mass = t["mass_kg"].as_f64().unwrap_or(0.0),
-            vol = t["volume_m3"].as_f64().unwrap_or(0.0),
-            pt = t["print_time_s"].as_f64().unwrap_or(0.0) / 60.0,
-            rt = t["robot_time_s"].as_f64().unwrap_or(0.0) / 60.0,
-            rl = t["relocation_time_s"].as_f64().unwrap_or(0.0) / 60.0,
-            json = s.to_string().replace("</", "<\\/"),
-        )
-    }
+        name = esc(design.name.as_str()),
+        nb = s["bays"].as_array().map_or(0, Vec::len),
+        len = design.ceiling.length,
+        ends = esc(&format!("{:?}", design.ceiling.ends)),
+        verdict = if s["ok"].as_bool() == Some(true) {
+            "pass"
+        } else {
+            "FAIL"
+        },
+        mass = t["mass_kg"].as_f64().unwrap_or(0.0),
+        vol = t["volume_m3"].as_f64().unwrap_or(0.0),
+        pt = t["print_time_s"].as_f64().unwrap_or(0.0) / 60.0,
+        rt = t["robot_time_s"].as_f64().unwrap_or(0.0) / 60.0,
+        rl = t["relocation_time_s"].as_f64().unwrap_or(0.0) / 60.0,
+        json = s.to_string().replace("</", "<\\/"),
+    )
 }

@@ -18,6 +18,7 @@
 //! specific to this problem.
 
 use std::collections::BTreeMap;
+use std::ops::ControlFlow;
 
 use serde::{Deserialize, Serialize};
 
@@ -363,6 +364,20 @@ pub fn optimize(
     start: &Design,
     on_eval: &dyn Fn(&Evaluation),
 ) -> Result<OptimizeResult, DesignError> {
+    optimize_until(file, start, &|e| {
+        on_eval(e);
+        ControlFlow::Continue(())
+    })
+}
+
+/// [`optimize`] that `on_eval` can stop: `ControlFlow::Break` after an evaluation ends the loop
+/// with [`DesignError::Cancelled`] (the Python package's Ctrl-C).
+pub fn optimize_until(
+    file: &OptimizeFile,
+    start: &Design,
+    on_eval: &dyn Fn(&Evaluation) -> ControlFlow<()>,
+) -> Result<OptimizeResult, DesignError> {
+    let stopped = std::cell::Cell::new(false);
     let params = file.parameters()?;
     file.analysis.validate()?;
     file.verify.validate()?;
@@ -401,12 +416,17 @@ pub fn optimize(
             failing,
             accepted: false,
         };
-        on_eval(&e);
+        if on_eval(&e).is_break() {
+            stopped.set(true);
+        }
         evaluations.push(e);
         cache.insert(key(x), (violation, volume));
         (violation, volume)
     };
     let mut best = run(&x, &mut evaluations);
+    if stopped.get() {
+        return Err(DesignError::Cancelled);
+    }
     if let Some(e) = evaluations.last_mut() {
         e.accepted = true;
     }
@@ -426,6 +446,9 @@ pub fn optimize(
                 }
                 let before = evaluations.len();
                 let f = run(&y, &mut evaluations);
+                if stopped.get() {
+                    return Err(DesignError::Cancelled);
+                }
                 if better(f, best) {
                     best = f;
                     x = y;
@@ -485,4 +508,158 @@ pub fn optimize(
         at_bounds,
         verification,
     })
+}
+
+/// Why the starting design of an optimize file cannot be had.
+#[derive(Debug, thiserror::Error)]
+pub enum StartError {
+    /// The inline `[design]` table is out of range.
+    #[error("invalid inline design")]
+    Inline(#[source] DesignError),
+    /// `design = "FILE"` cannot be read.
+    #[error("cannot read the design file {}", path.display())]
+    Read {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// `design = "FILE"` is not a valid design.
+    #[error("invalid design file {}", path.display())]
+    Invalid {
+        path: std::path::PathBuf,
+        #[source]
+        source: DesignError,
+    },
+}
+
+/// The design the loop starts from: the design of a design file with an `[optimize]` table
+/// (`embedded`, from [`OptimizeFile::from_any_toml_str`]), else the optimize file's `design`
+/// (inline, or a path relative to `base`, the file's directory), else the default design.
+pub fn start_design(
+    file: &OptimizeFile,
+    embedded: Option<Design>,
+    base: &std::path::Path,
+) -> Result<Design, StartError> {
+    if let Some(d) = embedded {
+        return Ok(d);
+    }
+    Ok(match &file.design {
+        None => Design::default(),
+        Some(DesignSource::Inline(d)) => {
+            d.validate().map_err(StartError::Inline)?;
+            (**d).clone()
+        }
+        Some(DesignSource::Path(rel)) => {
+            let path = base.join(rel);
+            let text = std::fs::read_to_string(&path).map_err(|source| StartError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            Design::from_toml_str(&text).map_err(|source| StartError::Invalid { path, source })?
+        }
+    })
+}
+
+/// `optimize.json`: the free parameters and the result (every evaluation, the path taken,
+/// the verification).
+pub fn document(
+    file: &OptimizeFile,
+    result: &OptimizeResult,
+) -> Result<serde_json::Value, DesignError> {
+    Ok(serde_json::json!({
+        "format": "kappe.optimize",
+        "version": 1,
+        "free": file.parameters()?,
+        "result": result,
+    }))
+}
+
+/// The cubic decimetres of a volume, or `-`.
+fn dm3(v: Option<f64>, unit: bool) -> String {
+    v.map_or("-".into(), |v| {
+        if unit {
+            format!("{:.4} dm³", v * 1e3)
+        } else {
+            format!("{:.4}", v * 1e3)
+        }
+    })
+}
+
+/// The header of [`Evaluation::line`].
+pub fn evaluation_header() -> String {
+    format!(
+        "{:>5} {:>10} {:>10}  {:<40} failing",
+        "eval", "volume dm³", "violation", "parameters"
+    )
+}
+
+impl Evaluation {
+    /// One line per evaluation, under [`evaluation_header`] (parameters by their last name).
+    pub fn line(&self) -> String {
+        let params: Vec<String> = self
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{}={v:.4}", k.rsplit('.').next().unwrap_or(k)))
+            .collect();
+        format!(
+            "{:>5} {:>10} {:>10.4}  {:<40} {}",
+            self.evaluation,
+            dm3(self.volume_m3, false),
+            self.violation,
+            params.join(" "),
+            self.failing.join(", ")
+        )
+    }
+}
+
+impl OptimizeResult {
+    /// The outcome in words (what `kappe optimize` prints after the loop): the path taken,
+    /// the volumes, the verification, parameters at bounds and the binding constraints.
+    pub fn report(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::from("\npath taken (accepted moves):\n");
+        for e in self.evaluations.iter().filter(|e| e.accepted) {
+            let params: Vec<String> = e
+                .parameters
+                .iter()
+                .map(|(k, v)| format!("{k} = {v:.5}"))
+                .collect();
+            let _ = writeln!(
+                s,
+                "  #{:<4} {}  volume {}",
+                e.evaluation,
+                params.join(", "),
+                dm3(e.volume_m3, true)
+            );
+        }
+        let _ = writeln!(
+            s,
+            "{} evaluations; volume {} → {}",
+            self.evaluations.len(),
+            dm3(self.start_volume_m3, true),
+            dm3(self.volume_m3, true),
+        );
+        if let Some(a) = &self.verification {
+            s.push_str(&a.report());
+        }
+        if !self.at_bounds.is_empty() {
+            let _ = writeln!(s, "at bounds: {}", self.at_bounds.join(", "));
+        }
+        if self.feasible {
+            if !self.binding.is_empty() {
+                let _ = writeln!(
+                    s,
+                    "binding constraints (within 5 % of their limit): {}",
+                    self.binding.join(", ")
+                );
+            }
+        } else {
+            let _ = writeln!(
+                s,
+                "INFEASIBLE within the bounds; binding constraints: {}",
+                self.binding.join(", ")
+            );
+        }
+        s
+    }
 }

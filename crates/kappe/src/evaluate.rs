@@ -1,6 +1,7 @@
-//! The whole pipeline of one design: form-finding ([`crate::design_cap`]), then the analysis of
-//! every state ([`crate::analysis::analyze`], when asked for), the robot plan
-//! ([`crate::robot_plan::plan_robot`], when asked for), the verdict ([`crate::verdict`]), the
+//! The whole pipeline of one design: form-finding ([`crate::design_cap`]), then the robot plan
+//! ([`crate::robot_plan::plan_robot`], when asked for), the analysis of every state
+//! ([`crate::analysis::analyze`], when asked for; with a plan, the layers' ages come from the
+//! plan's clock), the verdict ([`crate::verdict`]), the
 //! summary (`summary.json`) and the report input ([`crate::report_input`]).
 //!
 //! [`run`] is what `kappe design`, every design of `kappe study` and the Python `kappe.design`
@@ -126,6 +127,9 @@ pub struct Outcome {
     /// The robot plan, or why there is none; `None` when planning was not asked for (or the
     /// design disables the robot).
     pub robot: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The base-pose tolerance check of the plan (`[robot.tolerance]`, issue 15); `None`
+    /// without a plan or with `check = false`.
+    pub base_tolerance: Option<kappe_robot::tolerance::ToleranceReport>,
     /// The analysis and robot results in report form.
     pub extras: ReportExtras,
     /// The verdict of [`crate::verdict::design_ok`].
@@ -170,21 +174,9 @@ fn evaluate_until(
     on_progress: OnProgress<'_>,
     stop: &AtomicBool,
 ) -> Result<Outcome, DesignError> {
-    let fe = Ticker::new(on_progress, stop, Stage::Analysis);
-    let analysis = match &options.analysis {
-        Some(o) => Some(crate::analysis::check::analyze_until(
-            &cap,
-            o,
-            &|total| fe.tick(total),
-            stop,
-        )?),
-        None => None,
-    };
-    check(stop)?;
-    let mut extras = analysis
-        .as_ref()
-        .map(extras_from_analysis)
-        .unwrap_or_default();
+    // The robot is planned first (planning does not depend on the analysis): with a plan, the
+    // structural check takes every layer's age from the plan's clock (issue 11). Programs are
+    // still handed out only when the design passes ([`Outcome::programs`]).
     let robot = if options.robot && cap.design.robot.enabled {
         let ticker = Ticker::new(on_progress, stop, Stage::Robot);
         ticker.report(0, 1);
@@ -195,14 +187,55 @@ fn evaluate_until(
     } else {
         None
     };
+    check(stop)?;
+    let schedule = plan_schedule(&cap, robot.as_ref())?;
+    let fe = Ticker::new(on_progress, stop, Stage::Analysis);
+    let analysis = match &options.analysis {
+        Some(o) => Some(crate::analysis::check::analyze_scheduled(
+            &cap,
+            o,
+            schedule.as_ref(),
+            &|total| fe.tick(total),
+            stop,
+        )?),
+        None => None,
+    };
+    check(stop)?;
+    let mut extras = analysis
+        .as_ref()
+        .map(extras_from_analysis)
+        .unwrap_or_default();
     if let Some(plan) = &robot {
         add_robot(&mut extras, plan);
     }
+    // A relocated base is never exactly where planned (issue 15): re-check the plan under the
+    // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
+    let tol = &cap.design.robot.tolerance;
+    let base_tolerance = match &robot {
+        Some(Ok(plan)) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
+            plan,
+            &tol.base_tolerance(),
+        )),
+        _ => None,
+    };
+    if tol.verdict
+        && extras.robot_error.is_none()
+        && let Some(r) = base_tolerance.as_ref().filter(|r| !r.ok())
+    {
+        extras.robot_error = Some(format!(
+            "the plan does not tolerate base-pose errors of ±{} m, ±{}°: {}",
+            tol.position,
+            tol.yaw_deg,
+            r.problems.first().cloned().unwrap_or_default()
+        ));
+    }
+    extras.schedule = report_schedule(&cap, analysis.as_ref(), schedule);
     let ok = crate::verdict::design_ok(&cap, &extras);
     Ok(Outcome {
         cap,
         analysis,
         robot,
+        base_tolerance,
         extras,
         ok,
         allow_fail: options.allow_fail,
@@ -221,7 +254,27 @@ impl Outcome {
         }
         let robot = match &self.robot {
             None => serde_json::json!({"planned": false, "reason": "disabled"}),
-            Some(Ok(plan)) => plan_summary(plan),
+            Some(Ok(plan)) => {
+                let mut v = plan_summary(plan);
+                if let (Some(obj), Some(t)) = (v.as_object_mut(), &self.base_tolerance) {
+                    obj.insert(
+                        "base_tolerance".into(),
+                        serde_json::json!({
+                            "ok": t.ok(),
+                            "position_m": t.tolerance.position,
+                            "yaw_deg": t.tolerance.yaw_deg,
+                            "stride": t.tolerance.stride,
+                            "poses_per_station": t.poses_per_station,
+                            "waypoints_checked": t.waypoints_checked,
+                            "min_clearance_m": t.min_clearance,
+                            "min_body_distance_m": t.min_body_distance,
+                            "problems": t.problems,
+                            "in_verdict": self.cap.design.robot.tolerance.verdict,
+                        }),
+                    );
+                }
+                v
+            }
             Some(Err(e)) => {
                 serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
             }
@@ -335,6 +388,37 @@ fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
         "layer_times": kappe_robot::layer_times(plan),
         "geometry": plan.meshes,
     })
+}
+
+/// The schedule of a successful robot plan (its clock: print moves, layer changes, dwell,
+/// station changes, waits), which the structural check then uses for the layers' ages; `None`
+/// without a plan (the check then uses path length / print speed and the waits).
+fn plan_schedule(
+    cap: &Cap,
+    robot: Option<&Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+) -> Result<Option<crate::schedule::Schedule>, DesignError> {
+    match robot {
+        Some(Ok(plan)) => {
+            let s = crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan))?;
+            Ok((s.layers.len() == cap.sections.layers.len()).then_some(s))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The report's schedule block: the plan's schedule (or path length / speed and the waits) with
+/// the analysis' governing checks and ages; `None` when the `[schedule]` does not fit the print
+/// (the summary then leaves the schedule out too).
+fn report_schedule(
+    cap: &Cap,
+    analysis: Option<&Analysis>,
+    schedule: Option<crate::schedule::Schedule>,
+) -> Option<kappe_report::PrintSchedule> {
+    let schedule = match schedule {
+        Some(s) => s,
+        None => crate::schedule::cap_schedule(cap).ok()?,
+    };
+    Some(crate::schedule::report_schedule(cap, analysis, &schedule))
 }
 
 /// Plan the robot with the design's `[schedule]` waits (so the printed schedule is the checked

@@ -61,9 +61,10 @@ impl Default for GreenOptions {
             buckling: true,
             strength: true,
             sliding: true,
-            // The factor is compared with a threshold; 1e-8 relative is far below any
-            // modelling error (as in the cap's analysis).
-            tolerance: 1e-8,
+            // A relative residual of 1e-6 bounds the factor's relative error by about
+            // 1e-12 / (relative gap to the next factor) (symmetric pencil: |λ − θ| ≤ ‖r‖²/gap),
+            // far below any modelling error; it saves Lanczos steps over 1e-8.
+            tolerance: 1e-6,
         }
     }
 }
@@ -163,6 +164,50 @@ pub fn check_state(
     time: &TimeModel,
     options: &GreenOptions,
 ) -> Result<GreenState, DesignError> {
+    check_state_warm(model, elements, ages, time, options, None).map(|(g, _)| g)
+}
+
+/// Mode 1 of a state per shell node (`[ux, uy, uz, rx, ry, rz]`, any scale): the start of the
+/// next state's eigensolve ([`check_state_warm`]).
+pub type ModeStart = Vec<[f64; 6]>;
+
+/// The warm start plus a seeded pseudo-random vector of the same size: the previous mode alone
+/// can miss the lowest one (a cylinder's circumferential harmonics are orthogonal, so a start
+/// of one wave number never picks up another); the random part keeps every mode in the Krylov
+/// space while the guess still shortens the iteration.
+fn with_noise(mut start: ModeStart) -> ModeStart {
+    let scale = start
+        .iter()
+        .flatten()
+        .fold(0.0_f64, |m, v| m.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    for v in start.iter_mut().flatten() {
+        // xorshift64*: deterministic, uniform in [−1, 1).
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        let r = (x.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+        *v += scale * NOISE * (2.0 * r - 1.0);
+    }
+    start
+}
+
+/// Size of the random part of a warm start relative to the guess's largest entry.
+const NOISE: f64 = 0.1;
+
+/// [`check_state`] with the Lanczos iteration started from `start` (e.g. the previous state's
+/// mode mapped onto this mesh) and this state's mode returned for the next one. The start saves
+/// steps only: the result meets the same residual bound (`kappe_fe::BucklingOptions::start`).
+pub fn check_state_warm(
+    model: &mut ShellModel,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &GreenOptions,
+    start: Option<ModeStart>,
+) -> Result<(GreenState, Option<ModeStart>), DesignError> {
+    let mut mode = None;
     let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
     let base = model.material_of(0);
     if !time.is_constant() {
@@ -181,10 +226,14 @@ pub fn check_state(
             modes: 1,
             tolerance: options.tolerance,
             sturm_check: false,
+            start: start.map(with_noise),
             ..Default::default()
         };
         match kappe_fe::buckling(model, &opts) {
-            Ok(r) => {
+            Ok(mut r) => {
+                if !r.modes.is_empty() {
+                    mode = Some(r.modes.swap_remove(0));
+                }
                 let b = match r.factors.first() {
                     Some(&blf) => BucklingOutcome::Factor { blf },
                     None => BucklingOutcome::NoPositiveFactor,
@@ -231,17 +280,28 @@ pub fn check_state(
         .filter_map(|(m, u)| u.map(|u| (*m, u)))
         .max_by(|a, b| a.1.total_cmp(&b.1));
     let failure = governing.filter(|(_, u)| *u > 1.0).map(|g| g.0);
-    Ok(GreenState {
-        buckling,
-        strength,
-        sliding,
-        failure,
-        governing: governing.map(|g| g.0),
-    })
+    Ok((
+        GreenState {
+            buckling,
+            strength,
+            sliding,
+            failure,
+            governing: governing.map(|g| g.0),
+        },
+        mode,
+    ))
 }
 
 /// The worst strength and the worst bed-joint sliding element of a state.
 pub type StressWorst = (Option<WorstElement>, Option<WorstElement>);
+
+/// [`CapGreen::state_checks`] of one cap state: its buckling, mode 1 (per network node) and
+/// the worst strength and sliding elements (None for a mechanism).
+pub type CapStateCheck = (
+    crate::analysis::buckling::StateBuckling,
+    crate::analysis::buckling::NetworkMode,
+    Option<StressWorst>,
+);
 
 /// The strength and bed-joint sliding checks of a solved state: the worst element of each
 /// (None when not asked for or without a strength model). `st` is the linear static solution of
@@ -330,12 +390,25 @@ pub struct CapGreen {
 }
 
 impl CapGreen {
-    /// From a designed cap (errors: an invalid time model or schedule).
+    /// From a designed cap with its schedule from path length / print speed and the waits
+    /// (errors: an invalid time model or schedule).
     pub fn new(cap: &crate::pipeline::Cap) -> Result<CapGreen, DesignError> {
+        CapGreen::with_schedule(cap, None)
+    }
+
+    /// From a designed cap and the schedule of its timed robot plan (`None`: path length /
+    /// print speed and the waits, [`crate::schedule::cap_schedule`]).
+    pub fn with_schedule(
+        cap: &crate::pipeline::Cap,
+        schedule: Option<&crate::schedule::Schedule>,
+    ) -> Result<CapGreen, DesignError> {
         let n = cap.frame.n;
         Ok(CapGreen {
             time: cap.design.time_model()?,
-            schedule: crate::schedule::cap_schedule(cap)?,
+            schedule: match schedule {
+                Some(s) => s.clone(),
+                None => crate::schedule::cap_schedule(cap)?,
+            },
             index_of: cap
                 .sections
                 .layers
@@ -395,6 +468,49 @@ impl CapGreen {
             }
         };
         Ok(Some(self.stress_checks_on(&shell, &st, top)))
+    }
+
+    /// Buckling, strength and bed-joint sliding of one cap state from one solve: the state's
+    /// shell (on the graded mesh of `options.grading` when set, `crate::window`) with
+    /// `material` (E per layer already aged), its buckling solve, and the strength and sliding
+    /// checks on that solve's static solution. The mode is keyed by the state's own network
+    /// nodes either way. `None` without a strength model or without a shell (a single layer):
+    /// the caller's plain buckling path then covers the state.
+    ///
+    /// On a graded mesh an element spanning several layers carries their mean membrane stress
+    /// and is checked with the age of its upper (younger, weaker) row: the stress peak at a
+    /// coarse row is smoothed, its strength taken low (`tests/green_state.rs` states how far
+    /// from the full mesh this lands).
+    pub fn state_checks(
+        &self,
+        state: &crate::states::State,
+        material: &crate::shell::ShellMaterial,
+        options: &crate::analysis::AnalysisOptions,
+        top: usize,
+    ) -> Result<Option<CapStateCheck>, DesignError> {
+        if self.time.strength.is_none() {
+            return Ok(None);
+        }
+        let graded;
+        let (reduced, node_map) = match &options.grading {
+            Some(g) => {
+                graded = crate::window::graded_state_map(state, g);
+                (&graded.0, Some(&graded.1))
+            }
+            None => (state, None),
+        };
+        let Ok(shell) = crate::shell::state_shell(reduced, material, options.row_stride) else {
+            return Ok(None);
+        };
+        let (b, mut mode, st) =
+            crate::analysis::buckling::shell_buckling_full(&shell, state.index, options)?;
+        if let Some(map) = node_map {
+            for (k, _) in &mut mode {
+                *k = map.get(*k).copied().unwrap_or(*k);
+            }
+        }
+        let worst = st.map(|st| self.stress_checks_on(&shell, &st, top));
+        Ok(Some((b, mode, worst)))
     }
 
     /// Strength and bed-joint sliding of the state with top print index `top` from the static

@@ -21,6 +21,7 @@ pub mod frame;
 pub mod green;
 pub mod material;
 pub mod mesh;
+pub mod output;
 pub mod path;
 pub mod pipeline;
 pub mod print_calibration;

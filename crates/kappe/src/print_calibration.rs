@@ -458,3 +458,71 @@ pub fn calibrate_prints(
         explanation: explanation.trim_end().to_string(),
     })
 }
+
+/// The buildability spec a print calibration file names: inline, or read relative to `base`
+/// (the calibration file's directory).
+///
+/// # Errors
+/// The spec cannot be read or does not parse.
+pub fn resolve_spec(
+    file: &PrintCalibrationFile,
+    base: &std::path::Path,
+) -> Result<BuildabilitySpec, crate::calibrate::SourceError> {
+    use crate::calibrate::SourceError;
+    match &file.buildability {
+        SpecSource::Inline(s) => Ok((**s).clone()),
+        SpecSource::Path(rel) => {
+            let path = base.join(rel);
+            let text = std::fs::read_to_string(&path).map_err(|source| SourceError::ReadSpec {
+                path: path.clone(),
+                source,
+            })?;
+            BuildabilitySpec::parse(&text).map_err(|source| SourceError::Spec { path, source })
+        }
+    }
+}
+
+/// The calibration as the JSON document `kappe calibrate --json/--out` writes.
+pub fn document(file: &PrintCalibrationFile, cal: &PrintCalibration) -> serde_json::Value {
+    serde_json::json!({
+        "format": "kappe.calibration.prints",
+        "version": 1,
+        "fit": file.fit,
+        "calibration": cal,
+    })
+}
+
+/// The calibration as the text report `kappe calibrate` prints (one line per print, the
+/// estimate with its interval, the explanation), newline-terminated.
+pub fn text_report(cal: &PrintCalibration) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let name = cal.parameter.name();
+    let _ = writeln!(s, "Calibration of {name} from {} prints", cal.prints.len());
+    let _ = writeln!(
+        s,
+        "  {:<12} {:>9} {:>14} {:>14} {:>10} {:>9}",
+        "print", "observed", "lower", "upper", "predicted", "mode"
+    );
+    let f = |v: Option<usize>| v.map_or("stood".to_string(), |x| x.to_string());
+    for e in &cal.prints {
+        let _ = writeln!(
+            s,
+            "  {:<12} {:>9} {:>14.6e} {:>14.6e} {:>10} {:>9}",
+            e.name,
+            f(e.observed_failure_layer),
+            e.lower,
+            e.upper,
+            f(e.predicted_failure_layer),
+            e.predicted_mode.map_or("-", |m| m.name())
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  {name} = {:.6e} ± {:.3e}  (allowed by the data: [{:.6e}, {:.6e}])",
+        cal.value, cal.uncertainty, cal.interval[0], cal.interval[1]
+    );
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", cal.explanation);
+    s
+}

@@ -89,6 +89,10 @@ pub struct ReportExtras {
     pub modes: Vec<(usize, f64, NetworkMode)>,
     /// The layer ageing the analysis used, if any.
     pub ageing: Option<Ageing>,
+    /// The print schedule, governing checks and layer ages (`crate::schedule::report_schedule`).
+    pub schedule: Option<kappe_report::PrintSchedule>,
+    /// The robot plan's slowdowns and clearances ([`robot_summary`]).
+    pub robot_summary: Option<kappe_report::RobotSummary>,
 }
 
 /// The analysis of `crate::analysis::analyze` as report extras: per-state BLF and verdict,
@@ -258,6 +262,7 @@ pub fn add_robot(
             extras.waypoint_times = times;
             extras.plan_end = Some(p.total_time);
             extras.cell = Some(plan_cell(p));
+            extras.robot_summary = Some(robot_summary(p));
             (
                 true,
                 format!(
@@ -283,6 +288,96 @@ pub fn add_robot(
         element: Some(element),
         pass,
     });
+}
+
+/// Where a plan's tool is slower than the design speed (and why), and the clearances of the
+/// capsules and of UR's collision meshes, at the waypoints and certified along the motion
+/// (`Plan::meshes`, `Plan::certified`), for the report's robot section.
+pub fn robot_summary(p: &kappe_robot::Plan) -> kappe_report::RobotSummary {
+    use kappe_report::{ClearanceRow, SlowdownRow};
+    let at = |c: &kappe_robot::meshes::ClearanceAt| {
+        format!(
+            "{} (station {}, layer {}, point {})",
+            c.what,
+            c.station + 1,
+            c.layer,
+            c.index
+        )
+    };
+    let mut clearances = Vec::new();
+    let certified = p.certified.as_ref();
+    clearances.push(ClearanceRow {
+        model: "capsules (arm and nozzle)".into(),
+        to: "environment".into(),
+        at_waypoints: p.min_clearance,
+        at: "print moves and layer changes, as planned".into(),
+        along_motion: certified.map(|c| c.clearance),
+    });
+
+    clearances.push(ClearanceRow {
+        model: "capsules".into(),
+        to: "self".into(),
+        at_waypoints: p.min_self_distance,
+        at: "as planned".into(),
+        along_motion: certified.map(|c| c.self_distance),
+    });
+    if let Some(m) = &p.meshes {
+        let along = m.along_motion.as_ref();
+        clearances.push(ClearanceRow {
+            model: "arm capsules".into(),
+            to: "environment".into(),
+            at_waypoints: m.capsules.environment.distance,
+            at: at(&m.capsules.environment),
+            along_motion: None,
+        });
+        clearances.push(ClearanceRow {
+            model: "arm meshes (UR)".into(),
+            to: "environment".into(),
+            at_waypoints: m.meshes.environment.distance,
+            at: at(&m.meshes.environment),
+            along_motion: along.map(|a| a.environment.distance),
+        });
+        clearances.push(ClearanceRow {
+            model: "nozzle (capsule)".into(),
+            to: "environment".into(),
+            at_waypoints: m.nozzle.distance,
+            at: at(&m.nozzle),
+            along_motion: along.map(|a| a.nozzle.distance),
+        });
+        clearances.push(ClearanceRow {
+            model: "arm capsules".into(),
+            to: "self".into(),
+            at_waypoints: m.capsules.self_distance.distance,
+            at: at(&m.capsules.self_distance),
+            along_motion: None,
+        });
+        clearances.push(ClearanceRow {
+            model: "arm meshes (UR)".into(),
+            to: "self".into(),
+            at_waypoints: m.meshes.self_distance.distance,
+            at: at(&m.meshes.self_distance),
+            along_motion: along.map(|a| a.self_distance.distance),
+        });
+    }
+    kappe_report::RobotSummary {
+        design_speed: p.options.print_speed,
+        max_speed_ratio: p.max_speed_ratio,
+        max_acceleration_ratio: p.max_acceleration_ratio,
+        slowdowns: p
+            .slowdowns
+            .iter()
+            .map(|s| SlowdownRow {
+                station: s.station + 1,
+                from: s.from,
+                to: s.to,
+                min_speed_ratio: s.min_speed_ratio,
+                reason: s.reason.clone(),
+            })
+            .collect(),
+        clearances,
+        margin: p.options.clearance,
+        self_margin: p.options.self_clearance,
+    }
 }
 
 /// The constraint table: preliminary rows, replaced or extended by the analysis rows.
@@ -502,6 +597,8 @@ pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
         modes: mode_shapes(cap, extras),
         worst_places: Vec::new(),
         quantities: ageing_quantities(cap, extras),
+        schedule: extras.schedule.clone(),
+        robot_summary: extras.robot_summary.clone(),
     };
     input.worst_places = worst_places(cap, &input);
     input

@@ -50,11 +50,50 @@ pub fn robot_inputs(
         y0 - r.beams.overrun,
         y1 + r.beams.overrun,
     ));
+    setup.obstacles.extend(end_wall(cap, setup.floor_z));
     let mut opts = r.plan.clone();
     opts.print_speed = d.print.print_speed;
     opts.bead_radius = 0.5 * d.print.layer_width;
     opts.bead_offset = 0.5 * d.print.layer_height;
     (setup, opts)
+}
+
+/// Thickness of the end wall drawn as an obstacle, m (a masonry gable wall; only its face
+/// matters to the robot, which works in front of it).
+const END_WALL_THICKNESS: f64 = 0.25;
+/// How far the end wall reaches beyond the beams' outer faces and above the crown, m.
+const END_WALL_MARGIN: f64 = 0.5;
+
+/// The end wall of an end-wall cap (issue 15, `crate::ends`) as a robot obstacle: a vertical
+/// box behind the wall face, from the floor (or the beams' underside) to `END_WALL_MARGIN` above
+/// the crown, its front face through the crown of the inclined bearing plane (the point of the
+/// face farthest back: the vertical gable wall, with the inclined wedge in front of it below the
+/// crown, which lies behind layer 0 and so never in the robot's way). None for other ends.
+fn end_wall(cap: &Cap, floor_z: Option<f64>) -> Option<kappe_robot::collision::Obstacle> {
+    if cap.design.cap.end != crate::ends::EndKind::EndWall {
+        return None;
+    }
+    let face_y = cap
+        .final_state
+        .network
+        .nodes
+        .iter()
+        .filter(|n| n.role == crate::states::Role::ColumnEnd)
+        .map(|n| n.xyz.y)
+        .fold(f64::INFINITY, f64::min);
+    if !face_y.is_finite() {
+        return None;
+    }
+    let d = &cap.design;
+    let bottom = floor_z.unwrap_or(-d.robot.beams.height);
+    let top = d.cap.rise + END_WALL_MARGIN;
+    let half_x = 0.5 * d.cap.span + d.robot.beams.width + END_WALL_MARGIN;
+    Some(kappe_robot::collision::Obstacle::Box {
+        name: "end_wall".into(),
+        center: [0.0, face_y - 0.5 * END_WALL_THICKNESS, 0.5 * (bottom + top)],
+        half_extents: [half_x, 0.5 * END_WALL_THICKNESS, 0.5 * (top - bottom).abs()],
+        yaw: 0.0,
+    })
 }
 
 /// Plan the robot for the whole print: a continuous bead per station, timed on one clock (the

@@ -113,6 +113,58 @@ pub struct RobotSpec {
     pub setup: kappe_robot::setup::RobotSetup,
     /// Planner settings.
     pub plan: kappe_robot::setup::PlanOptions,
+    /// The base-pose tolerance check of the plan (issue 15): `[robot.tolerance]`.
+    #[serde(skip_serializing_if = "ToleranceSpec::is_default")]
+    pub tolerance: ToleranceSpec,
+}
+
+/// `[robot.tolerance]`: the base-pose errors a relocated mobile base must tolerate
+/// (`kappe_robot::tolerance::check_base_tolerance`, run by `kappe design` on every plan and
+/// reported in `summary.json` under `robot.base_tolerance`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ToleranceSpec {
+    /// Run the check at all.
+    pub check: bool,
+    /// Largest position error of the base in x and y, m.
+    pub position: f64,
+    /// Largest yaw error of the base, degrees.
+    pub yaw_deg: f64,
+    /// Check every n-th waypoint of a layer (and always its first and last).
+    pub stride: usize,
+    /// A plan that does not tolerate the errors fails the design. Off by default until the
+    /// planner keeps the margins the check needs (the default design's plan fails it at
+    /// ±10 mm, ±1°: a self-distance of 3.5 mm at station 0, layer 66).
+    pub verdict: bool,
+}
+
+impl Default for ToleranceSpec {
+    fn default() -> Self {
+        let t = kappe_robot::tolerance::BaseTolerance::default();
+        ToleranceSpec {
+            check: true,
+            position: t.position,
+            yaw_deg: t.yaw_deg,
+            stride: t.stride,
+            verdict: false,
+        }
+    }
+}
+
+impl ToleranceSpec {
+    /// Whether this is the default (kept out of resolved design files).
+    pub fn is_default(&self) -> bool {
+        *self == ToleranceSpec::default()
+    }
+
+    /// The robot crate's tolerance.
+    pub fn base_tolerance(&self) -> kappe_robot::tolerance::BaseTolerance {
+        kappe_robot::tolerance::BaseTolerance {
+            position: self.position,
+            yaw_deg: self.yaw_deg,
+            stride: self.stride,
+        }
+    }
 }
 
 /// Two beams along y whose tops are the base plane and whose inner faces are the springing lines.
@@ -144,6 +196,7 @@ impl Default for RobotSpec {
             beams: BeamSpec::default(),
             setup: kappe_robot::setup::RobotSetup::default(),
             plan: kappe_robot::setup::PlanOptions::default(),
+            tolerance: ToleranceSpec::default(),
         }
     }
 }

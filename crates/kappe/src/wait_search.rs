@@ -17,7 +17,8 @@
 
 use serde::Serialize;
 
-use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling, state_material};
+use crate::analysis::buckling::state_material_with;
+use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling};
 use crate::error::DesignError;
 use crate::green::{CapGreen, FailureMode};
 use crate::pipeline::Cap;
@@ -83,19 +84,23 @@ pub fn check_state_on(
         cap.design.print.start_arch_fraction,
         top,
     )?;
-    let mut material = state_material(cap, options, top);
     let mut g = green.clone();
     g.schedule = schedule.clone();
+    let mut material = state_material_with(cap, options, top, Some(&g));
     if !g.time.is_constant() {
         material.layer_modulus = g.layer_moduli(cap, top);
     }
-    let b = state_buckling(&state, &material, options)?;
+    // One solve gives the BLF and the stresses (graded mesh when `options.grading` is set);
+    // without a strength model (or a shell) the plain buckling check.
+    let (b, checks) = match g.state_checks(&state, &material, options, top)? {
+        Some((b, _, worst)) => (b, worst),
+        None => (state_buckling(&state, &material, options)?, None),
+    };
     let blf = match b.status {
         BucklingStatus::Analysed => b.factors.first().copied(),
         BucklingStatus::Mechanism => Some(0.0),
         _ => None,
     };
-    let checks = g.stress_checks(&state, &material, options.row_stride, top)?;
     let (st, sl) = checks.unwrap_or((None, None));
     let blf_min = cap.design.constraints.blf_min;
     let candidates = [
@@ -192,4 +197,67 @@ pub fn least_waits(
         infeasible,
         states,
     })
+}
+
+/// `schedule.json` of `kappe schedule`: the time model, the bound on each wait and the plan.
+///
+/// # Errors
+/// An invalid `[material.time]`.
+pub fn document(
+    design: &crate::spec::Design,
+    wait_max: f64,
+    plan: &WaitPlan,
+) -> Result<serde_json::Value, DesignError> {
+    Ok(serde_json::json!({
+        "format": "kappe.schedule",
+        "version": 1,
+        "time_model": design.time_model()?,
+        "wait_max_s": wait_max,
+        "plan": plan,
+    }))
+}
+
+/// The text `kappe schedule` prints: print times, each binding wait, the states that fail
+/// even at `wait_max`, and the `[schedule] waits = [...]` lines for the design.
+pub fn text_report(plan: &WaitPlan, wait_max: f64) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{} states; print time {:.1} s without waits, {:.1} s with the least waits ({:.1} s of waits)",
+        plan.states.len(),
+        plan.total_without_waits_s,
+        plan.total_s,
+        plan.schedule.total_wait_s()
+    );
+    for b in &plan.binding {
+        let _ = writeln!(
+            t,
+            "  state {:>4}: wait {:.1} s before its top layer ({} binds)",
+            b.state,
+            b.wait_s,
+            b.check.map_or("-", |m| m.name())
+        );
+    }
+    for c in &plan.infeasible {
+        let _ = writeln!(
+            t,
+            "  state {:>4}: FAILS even with {:.0} s of wait ({} governs; BLF {:?}, strength {:?}, sliding {:?})",
+            c.state,
+            wait_max,
+            c.governing.map_or("-", |m| m.name()),
+            c.blf,
+            c.strength,
+            c.sliding
+        );
+    }
+    let list: Vec<String> = plan
+        .schedule
+        .layers
+        .iter()
+        .map(|l| format!("{:.1}", l.wait_s))
+        .collect();
+    let _ = writeln!(t, "add to the design to print and check this schedule:");
+    let _ = writeln!(t, "[schedule]\nwaits = [{}]", list.join(", "));
+    t
 }

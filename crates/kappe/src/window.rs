@@ -10,15 +10,24 @@
 //! layers (clamped at the cut; [`window_shell`], kept for the record) is 23–34 % off on the
 //! default cap. What the mode *is* is smooth in depth: so the mesh keeps every layer as a row
 //! near the top, where the mode and the stresses change fastest, and thins the rows out with
-//! depth ([`graded_rows`]: `fine` rows at stride 1, then `fine` rows at stride 2, 4, … up to
-//! `max_stride` layers per row). The number of rows, and so the cost per state, then grows like
-//! `fine·log2(max_stride) + depth/max_stride` instead of `depth`.
+//! depth ([`graded_rows`]: the newest `fine` layers at stride 1, then `zone_rows` rows at each of
+//! the strides 2, 4, … up to `max_stride` layers per row, which goes on to the bed). Deep rows are
+//! also thinned along the layer ([`Grading::transverse`]: every c-th node, c the largest power of
+//! two keeping the facets about square, at most `transverse`). The shell's DOFs then grow like
+//! `fine + zone_rows·log2(max_stride) + depth/max_stride` rows instead of `depth`.
 //!
-//! **Checked against the full mesh** (`examples/graded_check.rs`, every state, release): with
-//! the default grading (fine 32, max stride 32) the largest BLF difference over every state is
-//! 0.27 % on the default cap and 0.59 % on the 1.2 m cap, and the governing state is the same;
-//! fine 16 gives 1.3 % and 2.6 % (too coarse near the top), fine 24 gives 0.53 % and 1.15 %.
-//! `tests/scale.rs` repeats the check at a coarser path sampling (see there).
+//! Rows are anchored at print index 0 (a row is kept when its index is a multiple of its stride),
+//! so the mesh of a state is the previous state's mesh less a few rows plus the new top layer:
+//! [`crate::analysis::analyze`] starts each state's Lanczos iteration from the previous state's
+//! mode ([`crate::analysis::buckling::state_buckling_warm`]), about 30 % fewer CPU seconds.
+//!
+//! **Checked against the full mesh** (`examples/graded_check.rs`, every state, the analysis as
+//! `kappe design` runs it, release): with the default grading (fine 32, max stride 32, zone rows
+//! 12, transverse 4) the largest BLF difference over every state is 0.22 % (state 67) on the
+//! default cap and 0.56 % (state 79) on the 1.2 m cap, and the governing state is the same
+//! (112 and 196; its BLF 0.07 % and 0.17 % high). Coarser zones are cheaper and less accurate
+//! (1.2 m cap): zone rows 8 give 0.84 %, 4 give 1.8 %; fine 24 gives 1.1 %. `tests/scale.rs`
+//! repeats the check on every 8th state of the default cap.
 //!
 //! Independent of the element: the graded state is the state's network reduced to the kept rows,
 //! meshed by [`crate::shell::state_shell`] with whatever element it uses. Hand-written: the row
@@ -283,48 +292,68 @@ fn shell_buckling_from(shell: &StateShell, r: &kappe_fe::BucklingResult) -> Stat
 }
 
 /// A graded shell mesh along the print direction: every layer is a row near the top of the state,
-/// and the rows thin out with depth (see [`graded_rows`]).
+/// and the rows thin out with depth (see [`graded_rows`]); deep rows also thin out across the
+/// span ([`Grading::transverse`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Grading {
-    /// Rows kept at every stride before the stride doubles (the newest `fine` layers are all rows).
+    /// The newest `fine` layers are all rows (stride 1).
     pub fine: usize,
-    /// Largest stride (layers per mesh row) deep in the stack.
+    /// Largest stride (layers per mesh row) deep in the stack; a power of two.
     pub max_stride: usize,
+    /// Rows of every coarser zone (strides 2, 4, … below `max_stride`; the last zone is
+    /// unbounded).
+    pub zone_rows: usize,
+    /// Largest transverse coarsening: a row at stride s keeps every c-th node along the layer,
+    /// c the largest power of two with c·Δs ≤ s·pitch (near-square facets; Δs the node spacing
+    /// along the layer, pitch the spacing of the layers), at most `transverse`. 1: off.
+    pub transverse: usize,
 }
 
 impl Default for Grading {
     fn default() -> Self {
-        // Fine 32: the largest BLF difference over every state is 0.27 % (default cap) and
-        // 0.59 % (1.2 m cap); fine 16 gives 1.3 % and 2.6 % (module docs).
+        // Checked against the full mesh in every state of the default and the 1.2 m cap
+        // (module docs, `examples/graded_check.rs`).
         Grading {
             fine: 32,
             max_stride: 32,
+            zone_rows: 12,
+            transverse: 4,
         }
     }
 }
 
-/// Which of `n` rows (print order, the last is the newest) a graded mesh keeps: counted from the
-/// top, `fine` rows at stride 1, then `fine` rows at stride 2, 4, … up to `max_stride`; the first
-/// row (on the bed or the wall) is always kept.
-pub fn graded_rows(n: usize, g: &Grading) -> Vec<bool> {
-    let mut keep = vec![false; n];
-    if n == 0 {
-        return keep;
-    }
-    let fine = g.fine.max(1);
-    let (mut d, mut stride, mut in_zone) = (0usize, 1usize, 0usize);
-    while d < n {
-        keep[n - 1 - d] = true;
-        in_zone += 1;
-        if in_zone == fine && stride < g.max_stride.max(1) {
-            stride = (stride * 2).min(g.max_stride.max(1));
-            in_zone = 0;
+impl Grading {
+    /// The stride of a row `depth` layers below the top (0 = the top layer).
+    pub fn stride_at(&self, depth: usize) -> usize {
+        let max_stride = self.max_stride.max(1);
+        let zone_rows = self.zone_rows.max(1);
+        if depth < self.fine.max(1) {
+            return 1;
         }
-        d += stride;
+        let (mut start, mut stride) = (self.fine.max(1), 2usize);
+        while stride < max_stride {
+            let end = start + zone_rows * stride;
+            if depth < end {
+                return stride;
+            }
+            start = end;
+            stride *= 2;
+        }
+        max_stride
     }
-    keep[0] = true;
-    keep
+}
+
+/// Which of `n` rows (print order, the last is the newest) a graded mesh keeps: a row `d`
+/// layers below the top is kept when its print index is a multiple of
+/// [`Grading::stride_at`]`(d)`; the first row (on the bed or the wall) and the top row always.
+/// The rows are anchored at print index 0, not at the top, so the kept rows of a state are the
+/// kept rows of the previous state less a few and plus the new top layer (strides only grow with
+/// depth and are powers of two): the previous state's mode is a good start for this one.
+pub fn graded_rows(n: usize, g: &Grading) -> Vec<bool> {
+    (0..n)
+        .map(|q| q == 0 || q.is_multiple_of(g.stride_at(n - 1 - q)))
+        .collect()
 }
 
 /// The state's network reduced to the rows a graded mesh keeps (nodes only: the shell is built
@@ -334,24 +363,65 @@ pub fn graded_state(state: &State, g: &Grading) -> State {
     graded_state_map(state, g).0
 }
 
+/// Indices `0 = i_0 < … < i_m = len − 1` of the nodes a row of `len` nodes keeps when thinned by
+/// `c`: m = ⌈(len − 1)/c⌉ nearly equal steps (so no sliver at the far foot).
+fn thinned(len: usize, c: usize) -> Vec<usize> {
+    if c <= 1 || len <= 2 {
+        return (0..len).collect();
+    }
+    let m = (len - 1).div_ceil(c).max(1);
+    (0..=m).map(|j| (j * (len - 1) + m / 2) / m).collect()
+}
+
+/// Fewest segments a transversally thinned row keeps (the arch needs a few facets to bend).
+const MIN_ROW_SEGMENTS: usize = 8;
+
 /// [`graded_state`] and, for every node of the reduced network, its index in `state`'s network.
 pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
     let net = &state.network;
     let rows = crate::shell::layer_rows(net);
-    let keep = graded_rows(rows.len(), g);
-    let kept: std::collections::HashSet<i32> = rows
+    let n = rows.len();
+    let keep = graded_rows(n, g);
+    // Δs and the layer pitch at the top (both are uniform along the cap).
+    let pitch_ratio = match (rows.last(), n.checked_sub(2).and_then(|k| rows.get(k))) {
+        (Some((_, top)), Some((_, below))) if top.len() >= 2 && top.len() == below.len() => {
+            let mid = top.len() / 2;
+            let d = |a: usize, b: usize| {
+                let (Some(p), Some(q)) = (net.nodes.get(a), net.nodes.get(b)) else {
+                    return 0.0;
+                };
+                (p.xyz - q.xyz).norm()
+            };
+            let seg = d(top[mid - 1], top[mid]);
+            if seg > 0.0 {
+                d(top[mid], below[mid]) / seg
+            } else {
+                0.0
+            }
+        }
+        _ => 0.0,
+    };
+    let mut map = Vec::new();
+    for (q, ((_, row), k)) in rows.iter().zip(&keep).enumerate() {
+        if !*k {
+            continue;
+        }
+        let stride = g.stride_at(n - 1 - q);
+        let mut c = 1usize;
+        while 2 * c <= g.transverse.max(1)
+            && (2 * c) as f64 <= stride as f64 * pitch_ratio
+            && (row.len().saturating_sub(1)) / (2 * c) >= MIN_ROW_SEGMENTS
+        {
+            c *= 2;
+        }
+        map.extend(thinned(row.len(), c).into_iter().filter_map(|j| row.get(j)));
+    }
+    // The network stores the layers top-down; keep that order.
+    map.sort_unstable();
+    let nodes = map
         .iter()
-        .zip(&keep)
-        .filter(|(_, k)| **k)
-        .map(|(r, _)| r.0)
+        .filter_map(|&i| net.nodes.get(i).cloned())
         .collect();
-    let (map, nodes): (Vec<usize>, Vec<crate::states::NetNode>) = net
-        .nodes
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| n.role != crate::states::Role::ColumnEnd && kept.contains(&n.layer))
-        .map(|(i, n)| (i, n.clone()))
-        .unzip();
     let reduced = State {
         index: state.index,
         layers_printed: state.layers_printed,

@@ -3,22 +3,11 @@
 
 use kappe::ceiling::{BayEnds, CeilingDesign, EXAMPLE_TOML, is_ceiling_toml, run_ceiling};
 
-const SMALL: &str = r#"
-name = "small room"
-[ceiling]
-length = 0.5
-ends = "both_walls"
-rise_ratio = 0.25
-[[bay]]
-span = 0.4
-[[bay]]
-span = 0.5
-[[bay]]
-name = "narrow"
-span = 0.35
-[print]
-path_sampling = 0.04
-"#;
+/// The three-bay room shared with the other ceiling tests.
+const SMALL: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/small_room.toml"
+));
 
 #[test]
 fn three_bay_ceiling_end_to_end() {
@@ -101,4 +90,53 @@ fn example_ceiling_parses_and_bad_input_is_named() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("cap.span") && e.contains("bay 1"), "{e}");
+}
+
+/// The base-pose tolerance check runs inside the design pipeline (`[robot.tolerance]`): no error
+/// always passes; an error far beyond what the plan can absorb (0.3 m, 20°: the targets move out
+/// of the planned IK branch) fails, is reported in `summary.json`, and fails the design only
+/// with `verdict = true`.
+#[test]
+fn base_tolerance_in_the_design_pipeline() {
+    let mut d = kappe::Design::default();
+    d.cap.length = 0.08;
+    let options = kappe::Options {
+        analysis: None,
+        ..kappe::Options::of(&d)
+    };
+    let go = |_: kappe::Progress| std::ops::ControlFlow::Continue(());
+    d.robot.tolerance.position = 0.0;
+    d.robot.tolerance.yaw_deg = 0.0;
+    let zero = kappe::run(&d, &options, &go).unwrap();
+    assert!(zero.robot.as_ref().is_some_and(|p| p.is_ok()));
+    let t = zero.base_tolerance.as_ref().unwrap();
+    assert!(t.ok(), "{:?}", t.problems);
+    assert_eq!(zero.summary()["robot"]["base_tolerance"]["ok"], true);
+
+    d.robot.tolerance.position = 0.3;
+    d.robot.tolerance.yaw_deg = 20.0;
+    d.robot.tolerance.stride = 8;
+    let far = kappe::run(&d, &options, &go).unwrap();
+    assert!(!far.base_tolerance.as_ref().unwrap().ok());
+    let s = far.summary();
+    assert_eq!(s["robot"]["base_tolerance"]["ok"], false);
+    assert_eq!(s["robot"]["base_tolerance"]["in_verdict"], false);
+    // Reported only: the verdict is the one without the check.
+    assert_eq!(far.ok, zero.ok);
+
+    d.robot.tolerance.verdict = true;
+    let enforced = kappe::run(&d, &options, &go).unwrap();
+    assert!(
+        !enforced.ok,
+        "with verdict = true the failure fails the design"
+    );
+    assert!(
+        enforced
+            .extras
+            .robot_error
+            .as_deref()
+            .is_some_and(|e| e.contains("base-pose errors")),
+        "{:?}",
+        enforced.extras.robot_error
+    );
 }

@@ -240,3 +240,60 @@ fn long_bay_against_an_end_wall() {
     let plain = kappe::run(&Design::default(), &stresses_only, &kappe::no_progress).unwrap();
     assert!(plain.summary().get("end_wall").is_none());
 }
+
+/// The end wall is a robot obstacle (`kappe::robot_plan::robot_inputs`): a box behind the wall
+/// face, clear of every print target and bead (they all lie in front of the face), spanning the
+/// beams; a start-section cap has no wall.
+#[test]
+fn end_wall_is_a_robot_obstacle() {
+    use kappe_robot::collision::Obstacle;
+    let mut d = Design::default();
+    d.cap.length = 0.2;
+    let start = kappe::design_cap(&d, &|_| {}).unwrap();
+    let (setup, _) = kappe::robot_plan::robot_inputs(&start);
+    assert!(setup.obstacles.iter().all(|o| o.name() != "end_wall"));
+    d.cap.end = EndKind::EndWall;
+    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
+    let (setup, _) = kappe::robot_plan::robot_inputs(&cap);
+    let walls: Vec<_> = setup
+        .obstacles
+        .iter()
+        .filter_map(|o| match o {
+            Obstacle::Box {
+                name,
+                center,
+                half_extents,
+                yaw,
+            } if name == "end_wall" => Some((*center, *half_extents, *yaw)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(walls.len(), 1);
+    let (c, h, yaw) = walls[0];
+    assert_eq!(yaw, 0.0);
+    let front = c[1] + h[1];
+    // Its front face is the wall face farthest back: the column ends (on the inclined face).
+    let face = cap
+        .final_state
+        .network
+        .nodes
+        .iter()
+        .filter(|n| n.role == Role::ColumnEnd)
+        .map(|n| n.xyz.y)
+        .fold(f64::INFINITY, f64::min);
+    // 1e-12 m: the same number through one addition and subtraction.
+    assert!((front - face).abs() < 1e-12, "{front} vs {face}");
+    // Every bead centre lies in front of the wall by at least half a layer pitch (the bead of
+    // layer 0 touches the inclined face at its own height, the vertical wall is behind that).
+    let half_pitch = 0.5 * d.print.layer_height;
+    for p in &cap.path.points {
+        assert!(
+            p.bead.y > front + half_pitch,
+            "bead at y {} vs wall {front}",
+            p.bead.y
+        );
+    }
+    // It spans the beams and reaches from below the beams to above the crown.
+    assert!(h[0] >= 0.5 * d.cap.span + d.robot.beams.width);
+    assert!(c[2] - h[2] <= -d.robot.beams.height && c[2] + h[2] >= d.cap.rise);
+}

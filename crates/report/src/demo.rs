@@ -640,5 +640,27 @@ pub fn demo_input() -> ReportInput {
         modes,
         worst_places,
         quantities: vec![age],
+        schedule: None,
+        robot_summary: Some(crate::robot_summary::RobotSummary {
+            design_speed: 0.05,
+            max_speed_ratio: 0.62,
+            max_acceleration_ratio: 0.81,
+            slowdowns: vec![crate::robot_summary::SlowdownRow {
+                station: 1,
+                from: (3, 10),
+                to: (3, 14),
+                min_speed_ratio: 0.86,
+                reason: "joint acceleration".into(),
+            }],
+            clearances: vec![crate::robot_summary::ClearanceRow {
+                model: "arm capsules".into(),
+                to: "environment".into(),
+                at_waypoints: 0.0555,
+                at: "wrist_3 – beam_right (station 1, layer 3)".into(),
+                along_motion: Some(0.031),
+            }],
+            margin: 0.01,
+            self_margin: 0.0,
+        }),
     }
 }

@@ -147,6 +147,9 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
         plot: p.clone(),
         ..PlotSpec::default()
     }));
+    if let Some(schedule) = &input.schedule {
+        specs.extend(crate::schedule::plots(schedule));
+    }
     let plots = specs
         .iter()
         .map(|s| render_plot(s).map(|r| (s, r)))
@@ -271,6 +274,12 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
         );
     }
     let _ = write!(h, "</tbody></table>\n</section>\n");
+    if let Some(schedule) = &input.schedule {
+        h.push_str(&crate::schedule::section_html(schedule));
+    }
+    if let Some(r) = &input.robot_summary {
+        h.push_str(&crate::robot_summary::section_html(r));
+    }
 
     // Plots, each with the data needed to draw the cursor of the current moment.
     let _ = write!(

@@ -62,6 +62,14 @@ pub struct ReportInput {
     /// appears in the colour menu and gets a min/max-over-progress plot.
     #[serde(default)]
     pub quantities: Vec<Quantity>,
+    /// The print schedule (layer start/end/wait), which check governs each analysed state and
+    /// the layer ages at the governing state(s) (issue 11).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub schedule: Option<crate::schedule::PrintSchedule>,
+    /// The robot plan's slowdowns and clearances (capsules and meshes, at the waypoints and
+    /// certified along the motion; issue 13).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot_summary: Option<crate::robot_summary::RobotSummary>,
 }
 
 /// The print on one clock: when the nozzle reaches each print-path point.
@@ -448,12 +456,18 @@ impl ReportInput {
         }
         self.validate_path(&has_layer)?;
         self.validate_states()?;
+        if let Some(schedule) = &self.schedule {
+            schedule.validate()?;
+        }
         for (ci, c) in self.constraints.iter().enumerate() {
             finite(|| format!("constraints[{ci}].limit"), c.limit)?;
             finite(|| format!("constraints[{ci}].worst"), c.worst)?;
         }
         if let Some(robot) = &self.robot {
             robot.validate(self.cell.as_ref())?;
+        }
+        if let Some(r) = &self.robot_summary {
+            r.validate()?;
         }
         self.validate_extras()?;
         for (pi, plot) in self.plots.iter().enumerate() {

@@ -408,6 +408,8 @@ pub(crate) fn island(input: &ReportInput) -> Value {
         "cell": input.cell,
         "modes": modes,
         "worst_places": input.worst_places,
+        "schedule": input.schedule,
+        "robot_summary": input.robot_summary,
     })
 }
 
@@ -646,6 +648,14 @@ pub fn read_island(json: &str) -> Result<ReportInput, ReportError> {
         modes,
         worst_places: serde_json::from_value(from("worst_places")?)?,
         quantities: Vec::new(),
+        schedule: match v.get("schedule") {
+            Some(v) if !v.is_null() => Some(serde_json::from_value(v.clone())?),
+            _ => None,
+        },
+        robot_summary: match v.get("robot_summary") {
+            Some(v) if !v.is_null() => Some(serde_json::from_value(v.clone())?),
+            _ => None,
+        },
     })
 }
 

@@ -54,6 +54,8 @@ mod html;
 mod input;
 mod island;
 mod plots;
+mod robot_summary;
+mod schedule;
 mod study;
 
 pub use demo::demo_input;
@@ -72,6 +74,8 @@ pub use plots::{
     CursorAxis, PLOT_SIZE, PlotFrame, PlotSpec, ReferenceLine, RenderedPlot, VerticalMarker,
     fmt_num, render_plot, render_svg, standard_plots,
 };
+pub use robot_summary::{ClearanceRow, RobotSummary, SlowdownRow};
+pub use schedule::{PrintSchedule, ScheduleRow, StateAges, StateGoverning};
 pub use study::{StudyCell, StudyColumn, StudyRow, StudyTable, render_study_html};
 
 /// The three.js revision of the vendored bundle (`THREE.REVISION`).

@@ -21,10 +21,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let rep = check_plan(&plan);
     println!(
-        "check_plan alone: {:.3} s ({} problems)",
+        "check_plan alone: {:.3} s ({} problems); at waypoints: clearance {:.4} m, self {:.4} m; certified along the motion: clearance {:.4} m (approach/retract {:.4} m), self {:.4} m ({} configurations)",
         t.elapsed().as_secs_f64(),
-        rep.problems.len()
+        rep.problems.len(),
+        rep.min_clearance,
+        rep.min_self_distance,
+        rep.certified_clearance,
+        rep.certified_approach_clearance,
+        rep.certified_self_distance,
+        rep.certified_configurations
     );
+    for p in rep.problems.iter().take(5) {
+        println!("  {p}");
+    }
     let t = Instant::now();
     let files = program_files(&plan, "program_part")?;
     let t_prog = t.elapsed().as_secs_f64();
@@ -72,6 +81,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         m.nozzle.what,
         m.problems.len()
     );
+    if let Some(a) = &m.along_motion {
+        println!(
+            "meshes along the motion (certified, {} configurations): arm {:.4} m (layer {}), nozzle {:.4} m (layer {}), self {:.4} m (layer {})",
+            a.configurations,
+            a.environment.distance,
+            a.environment.layer,
+            a.nozzle.distance,
+            a.nozzle.layer,
+            a.self_distance.distance,
+            a.self_distance.layer
+        );
+    }
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir)?;
         for f in &files {

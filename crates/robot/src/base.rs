@@ -69,11 +69,7 @@ fn coverage(ctx: &Context, w: &Iso, start: usize, stride: usize) -> usize {
         let len = layer.points.len();
         let ok = (0..len)
             .filter(|k| k % stride == 0 || *k == len - 1)
-            .all(|k| {
-                !ctx.vertices(&scene, &inv, w, &ctx.target_frame(layer, k), o)
-                    .0
-                    .is_empty()
-            });
+            .all(|k| ctx.has_vertex(&scene, &inv, w, &ctx.target_frame(layer, k), o));
         if !ok {
             break;
         }

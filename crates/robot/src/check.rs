@@ -4,14 +4,18 @@
 //! transitions between layers. Nothing computed by the planner (clearances, costs) is trusted.
 
 use parry3d_f64::glamx::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::frames::{Iso, angle_between};
-use crate::kinematics::{JOINT_LIMITS, UR10E, within_limits};
+use crate::kinematics::{Joints, UR10E, within_limits};
 use crate::plan::Station;
 use crate::plan::{CLEARANCE_CUTOFF, Plan, transition_collision, validate};
 use crate::setup::PlanOptions;
 use crate::setup::{PathPoint, PrintLayer};
+
+/// Smallest certified clearance of the approach and retract moves (m): clear of contact.
+const CONTACT: f64 = 1e-9;
 
 /// Tolerance of the TCP position (m) and tool axis (rad) on the targets (acceptance: 1e-6).
 pub const TARGET_TOL: f64 = 1e-6;
@@ -27,6 +31,21 @@ pub struct CheckReport {
     /// Largest |q̇_j| / (s·v_j,max) and |q̈_j| / a_j,max over the rows of the trajectory.
     pub max_speed_ratio: f64,
     pub max_acceleration_ratio: f64,
+    /// Certified smallest clearance to the environment along every print move (layer changes
+    /// included), joint-interpolated between the waypoints ([`crate::sweep`]): a lower bound,
+    /// not a sample (m, capped at 0.5); split until it holds the margin `clearance`.
+    #[serde(default)]
+    pub certified_clearance: f64,
+    /// The same along the station approaches and retracts, which need only be clear of contact
+    /// (they descend onto and leave the print).
+    #[serde(default)]
+    pub certified_approach_clearance: f64,
+    /// Certified smallest self distance along the same motions (m).
+    #[serde(default)]
+    pub certified_self_distance: f64,
+    /// Configurations measured for the certified bounds (waypoints and added midpoints).
+    #[serde(default)]
+    pub certified_configurations: usize,
     pub problems: Vec<String>,
 }
 
@@ -35,6 +54,9 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
     let mut rep = CheckReport {
         min_clearance: f64::INFINITY,
         min_self_distance: f64::INFINITY,
+        certified_clearance: f64::INFINITY,
+        certified_approach_clearance: f64::INFINITY,
+        certified_self_distance: f64::INFINITY,
         ..Default::default()
     };
     let mut problems = Vec::new();
@@ -58,6 +80,26 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         problems.push("flange_from_tcp differs from the setup's tool".to_string());
     }
     let opts = &plan.options;
+    // Motion bounds of the two models (see crate::sweep): the environment channel is any
+    // environment capsule's world motion, the self channel any checked pair's relative motion.
+    let env_bounds =
+        crate::sweep::SweepBounds::for_capsules(&UR10E, &ctx.env_model.capsules, [0.0; 8]);
+    let self_bounds =
+        crate::sweep::SweepBounds::for_capsules(&UR10E, &ctx.self_model.capsules, [0.0; 8]);
+    let env_links: Vec<usize> = ctx.env_model.capsules.iter().map(|c| c.link).collect();
+    let displacement = |tv: &[f64; 6]| -> [f64; 2] {
+        let env = env_links
+            .iter()
+            .map(|&k| env_bounds.world(tv, k))
+            .fold(0.0, f64::max);
+        let slf = ctx
+            .self_model
+            .self_pairs
+            .iter()
+            .map(|&(a, b)| self_bounds.relative(tv, a, b))
+            .fold(0.0, f64::max);
+        [env, slf]
+    };
     let mut order = 0usize;
     let mut last_t = f64::NEG_INFINITY;
     for (si, st) in plan.stations.iter().enumerate() {
@@ -97,6 +139,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 &q,
                 &flange_from_tcp,
                 opts.program.approach_distance,
+                &ctx.limits,
             ) {
                 Ok(qa) => {
                     let posed = ctx.self_model.pose(&qa, &Iso::IDENTITY);
@@ -115,6 +158,69 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                     }
                 }
                 Err(e) => problems.push(format!("station {si}: {what}: {e}")),
+            }
+        }
+        // Certified along the motion: each layer's moves from the previous layer's end (the
+        // layer change is a printed move), with that layer's obstacles; the approach and the
+        // retract need only be clear of contact.
+        let mut motions: Vec<(Vec<Joints>, usize, [f64; 2], String)> = Vec::new();
+        for (what, q, tag) in ends.iter().flatten().map(|(q, tag, what)| (what, q, tag)) {
+            if let Ok(qa) = crate::program::approach_config(
+                q,
+                &flange_from_tcp,
+                opts.program.approach_distance,
+                &ctx.limits,
+            ) {
+                motions.push((
+                    vec![qa, *q],
+                    *tag,
+                    [CONTACT, opts.self_clearance],
+                    format!("station {si}: the {what}"),
+                ));
+            }
+        }
+        let mut prev: Option<Joints> = None;
+        for (o, l) in st.layers.iter().enumerate() {
+            let path: Vec<Joints> = prev
+                .into_iter()
+                .chain(l.waypoints.iter().map(|w| w.q))
+                .collect();
+            prev = l.waypoints.last().map(|w| w.q);
+            motions.push((
+                path,
+                order + o,
+                [opts.clearance, opts.self_clearance],
+                format!("station {si}: the moves of layer {}", l.layer),
+            ));
+        }
+        let run = |k: usize| {
+            // Split only where the bound is below the margin, so the certified minimum is a
+            // proof that the margin holds (tight only where it is near the margin).
+            let (path, tag, required, _) = &motions[k];
+            let measure = |q: &Joints| -> [f64; 2] {
+                let env = ctx.env_model.pose(q, &world_from_base);
+                let c = scene.clearance(env.as_slice(), *tag, CLEARANCE_CUTOFF);
+                let posed = ctx.self_model.pose(q, &Iso::IDENTITY);
+                [c.distance, ctx.self_model.min_self_distance_posed(&posed).0]
+            };
+            crate::sweep::certify(path, &measure, &displacement, *required, *required, None)
+        };
+        let certified: Vec<([f64; 2], usize)> =
+            (0..motions.len()).into_par_iter().map(run).collect();
+        for ((lb, n), (_, _, required, what)) in certified.iter().zip(&motions) {
+            if required[0] == CONTACT {
+                rep.certified_approach_clearance = rep.certified_approach_clearance.min(lb[0]);
+            } else {
+                rep.certified_clearance = rep.certified_clearance.min(lb[0]);
+            }
+            rep.certified_self_distance = rep.certified_self_distance.min(lb[1]);
+            rep.certified_configurations += n;
+            // 1e-9 m: round-off of re-posing the same capsules.
+            if lb[0] < required[0] - 1e-9 || lb[1] < required[1] - 1e-9 {
+                problems.push(format!(
+                    "{what}: along the motion the clearance is only certified ≥ {:.4} m (needs {} m) and the self distance ≥ {:.4} m (needs {} m)",
+                    lb[0], required[0], lb[1], required[1]
+                ));
             }
         }
         let mut prev_end: Option<[f64; 6]> = None;
@@ -150,7 +256,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                         at()
                     ));
                 }
-                if !within_limits(&q, &JOINT_LIMITS) {
+                if !within_limits(&q, &ctx.limits) {
                     problems.push(format!("{}: joints {q:?} outside the limits", at()));
                 }
                 if !ctx.margins_ok(&q, &base_flange) {

@@ -354,14 +354,33 @@ struct SceneShape {
     /// Axis-aligned bounds (min, max) used to skip far objects; infinite for half-spaces.
     lo: DVec3,
     hi: DVec3,
+    /// A box's half extents: a capsule's bounds in the box frame give a tighter lower bound of
+    /// their distance than the world-axis bounds, before the GJK query.
+    cuboid: Option<DVec3>,
 }
 
-/// Capsule chain segments, chunked with bounding boxes, tagged by layer.
+/// Capsule chain segments, chunked with bounding boxes, tagged by layer. Chunks are grouped
+/// (consecutive chunks, [`GROUP`] at a time) under a second level of boxes with the group's
+/// smallest layer tag, so that a query skips whole groups that are far or not yet printed: a
+/// two-level bounding-volume hierarchy. Both levels are lower bounds, so the result is exact.
 #[derive(Clone, Debug, Default)]
 pub struct SegmentSoup {
     segs: Vec<(DVec3, DVec3, f64)>,
     chunks: Vec<Chunk>,
+    groups: Vec<Group>,
 }
+
+#[derive(Clone, Debug)]
+struct Group {
+    min_layer: usize,
+    start: usize,
+    end: usize,
+    lo: DVec3,
+    hi: DVec3,
+}
+
+/// Chunks per group (≈ 48 segments, ≈ 1 m of bead at 2 cm spacing).
+const GROUP: usize = 8;
 
 #[derive(Clone, Debug)]
 struct Chunk {
@@ -405,7 +424,40 @@ impl SegmentSoup {
                 lo,
                 hi,
             });
+            let ci = self.chunks.len() - 1;
+            match self.groups.last_mut() {
+                Some(g) if g.end - g.start < GROUP => {
+                    g.end = ci + 1;
+                    g.min_layer = g.min_layer.min(layer);
+                    g.lo = g.lo.min(lo);
+                    g.hi = g.hi.max(hi);
+                }
+                _ => self.groups.push(Group {
+                    min_layer: layer,
+                    start: ci,
+                    end: ci + 1,
+                    lo,
+                    hi,
+                }),
+            }
         }
+    }
+
+    /// Chunks that may hold a segment with tag < `below_layer` within `lim` of the box
+    /// `lo`–`hi`, group by group (`lim` is re-read per group, as the caller shrinks it).
+    #[inline]
+    fn near_chunks<'a>(
+        &'a self,
+        lo: DVec3,
+        hi: DVec3,
+        below_layer: usize,
+        lim: &'a std::cell::Cell<f64>,
+    ) -> impl Iterator<Item = &'a Chunk> + 'a {
+        self.groups
+            .iter()
+            .filter(move |g| g.min_layer < below_layer && box_gap(lo, hi, g.lo, g.hi) <= lim.get())
+            .flat_map(move |g| &self.chunks[g.start..g.end])
+            .filter(move |ch| ch.layer < below_layer && box_gap(lo, hi, ch.lo, ch.hi) <= lim.get())
     }
 
     /// Smallest signed distance from capsule `c` to chunks with `layer < below_layer`, skipping
@@ -420,18 +472,16 @@ impl SegmentSoup {
         let clo = c.a.min(c.b) - DVec3::splat(c.radius);
         let chi = c.a.max(c.b) + DVec3::splat(c.radius);
         let mut best: Option<(f64, usize)> = None;
-        let mut lim = cutoff;
-        for ch in &self.chunks {
-            if ch.layer >= below_layer {
-                continue;
-            }
-            if box_gap(clo, chi, ch.lo, ch.hi) > lim {
-                continue;
-            }
+        let lim = std::cell::Cell::new(cutoff);
+        for ch in self.near_chunks(clo, chi, below_layer, &lim) {
             for &(a, b, r) in &self.segs[ch.start..ch.end] {
+                let rr = DVec3::splat(r);
+                if box_gap(clo, chi, a.min(b) - rr, a.max(b) + rr) > lim.get() {
+                    continue;
+                }
                 let d = segment_distance(c.a, c.b, a, b) - c.radius - r;
-                if d < lim {
-                    lim = d;
+                if d < lim.get() {
+                    lim.set(d);
                     best = Some((d, ch.name_idx));
                 }
             }
@@ -513,6 +563,7 @@ impl Scene {
                     shape: SharedShape::new(Cuboid::new(he)),
                     lo: DVec3::from(*center) - ext,
                     hi: DVec3::from(*center) + ext,
+                    cuboid: Some(he),
                 });
             }
             Obstacle::HalfSpace {
@@ -537,6 +588,7 @@ impl Scene {
                     shape: SharedShape::new(HalfSpace::new(n.normalize())),
                     lo: DVec3::splat(f64::NEG_INFINITY),
                     hi: DVec3::splat(f64::INFINITY),
+                    cuboid: None,
                 });
             }
             Obstacle::Capsules {
@@ -586,6 +638,7 @@ impl Scene {
                     shape: SharedShape::new(mesh),
                     lo,
                     hi,
+                    cuboid: None,
                 });
             }
         }
@@ -632,12 +685,24 @@ impl Scene {
             object: None,
         };
         let mut best_name: Option<&str> = None;
-        for c in caps {
+        // The tool and wrist come last in the models and are usually the nearest to the work:
+        // measuring them first shrinks the bound early, so that the rest is mostly pruned.
+        for c in caps.iter().rev() {
             let clo = c.a.min(c.b) - DVec3::splat(c.radius);
             let chi = c.a.max(c.b) + DVec3::splat(c.radius);
             for s in &self.shapes {
                 if box_gap(clo, chi, s.lo, s.hi) > best.distance {
                     continue;
+                }
+                if let Some(h) = s.cuboid {
+                    let (la, lb) = (
+                        s.pose.inverse_transform_point(c.a),
+                        s.pose.inverse_transform_point(c.b),
+                    );
+                    let r = DVec3::splat(c.radius);
+                    if box_gap(la.min(lb) - r, la.max(lb) + r, -h, h) > best.distance {
+                        continue;
+                    }
                 }
                 let capsule = Capsule::new(c.a, c.b, c.radius);
                 let d = match query::distance(&Pose::IDENTITY, &capsule, &s.pose, s.shape.as_ref())
@@ -691,26 +756,24 @@ impl Scene {
                 name = Some(&s.name);
             }
         }
-        for ch in &self.soup.chunks {
-            if ch.layer > layer_tag || box_gap(lo, hi, ch.lo, ch.hi) > best {
-                continue;
-            }
+        let lim = std::cell::Cell::new(best);
+        for ch in self.soup.near_chunks(lo, hi, layer_tag + 1, &lim) {
             for &(a, b, r) in &self.soup.segs[ch.start..ch.end] {
                 let seg_lo = a.min(b) - DVec3::splat(r);
                 let seg_hi = a.max(b) + DVec3::splat(r);
-                if box_gap(lo, hi, seg_lo, seg_hi) > best {
+                if box_gap(lo, hi, seg_lo, seg_hi) > lim.get() {
                     continue;
                 }
                 let c = Capsule::new(a, b, r);
                 if let Ok(d) = query::distance(pose, shape, &Pose::IDENTITY, &c)
-                    && d.distance < best
+                    && d.distance < lim.get()
                 {
-                    best = d.distance;
+                    lim.set(d.distance);
                     name = self.names.get(ch.name_idx).map(String::as_str);
                 }
             }
         }
-        (best, name.map(str::to_owned))
+        (lim.get(), name.map(str::to_owned))
     }
 }
 

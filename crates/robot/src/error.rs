@@ -60,6 +60,12 @@ pub enum RobotError {
     /// The print cannot be planned; names the first failing frame.
     #[error("cannot plan the print: {0}")]
     Unplannable(Box<PlanFailure>),
+    /// A joint position limit (`limits.position_deg`) is not a finite range inside the
+    /// controller's ±360°.
+    #[error(
+        "invalid joint position limit of joint {joint}: [{min}, {max}]°: need finite values, min < max, both within ±360° (the UR10e controller's range)"
+    )]
+    JointPositionLimit { joint: usize, min: f64, max: f64 },
     /// A plan failed its independent re-check (never exported).
     #[error("plan verification failed: {}", .0.join("; "))]
     Verification(Vec<String>),

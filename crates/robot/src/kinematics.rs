@@ -267,6 +267,21 @@ impl IkSolutions {
     }
 }
 
+/// Whether some whole-turn variant of `q` (the elbow as it is) lies inside `limits`: the
+/// planner's test of a canonical IK solution before the station's 2π offsets are chosen. For
+/// the UR10e limits this is the same as [`within_limits`] on canonical angles.
+pub fn representable_in_limits(q: &Joints, limits: &[[f64; 2]; 6]) -> bool {
+    (0..6).all(|j| {
+        // The elbow is never wound (its raw value is the configuration), the others may be
+        // shifted by whole turns when the station is unwrapped.
+        let ks: &[i32] = if j == 2 { &[0] } else { &[-2, -1, 0, 1, 2] };
+        ks.iter().any(|&k| {
+            let v = q[j] + f64::from(k) * TAU;
+            v >= limits[j][0] - 1e-12 && v <= limits[j][1] + 1e-12
+        })
+    })
+}
+
 /// Every joint vector equal to `q` modulo 2π per joint that lies inside `limits` (the ±2π
 /// "wind-up" variants; up to 2⁵·… of them). Joints whose canonical value is outside the limits
 /// yield nothing.

@@ -13,6 +13,7 @@ pub mod check;
 pub mod collision;
 pub mod error;
 pub mod export;
+pub mod files;
 pub mod frames;
 pub mod kinematics;
 pub mod ladder;
@@ -22,6 +23,7 @@ pub mod plan;
 pub mod program;
 pub mod setup;
 pub mod stations;
+pub mod sweep;
 pub mod synthetic;
 pub mod timing;
 pub mod tolerance;
@@ -31,8 +33,10 @@ pub use error::{FailureKind, PlanFailure, RobotError};
 pub use export::{urscript_programs, write_plan_json, write_trajectory_csv, write_urscript};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
-pub use lint::{LintReport, lint};
-pub use plan::{LayerPlan, Plan, Station, Waypoint, plan_print, plan_print_with_waits};
+pub use lint::{LintReport, lint, lint_with_limits};
+pub use plan::{
+    CertifiedClearance, LayerPlan, Plan, Station, Waypoint, plan_print, plan_print_with_waits,
+};
 pub use program::{ProgramFile, ProgramPart, index_json, program_files, resume_plan};
 pub use setup::{
     BasePlacement, BaseSearch, PathPoint, PlanOptions, PlannerKind, PrintLayer, ProgramOptions,

@@ -18,8 +18,6 @@ use std::collections::HashSet;
 
 use serde::Serialize;
 
-use crate::kinematics::JOINT_LIMITS;
-
 /// One function of the table: name, least and most arguments, keyword names (in order).
 pub struct Signature {
     pub name: &'static str,
@@ -425,6 +423,7 @@ fn check_call(
     defined: &HashSet<String>,
     problems: &mut Vec<String>,
     ln: usize,
+    limits: &[[f64; 2]; 6],
 ) {
     let Some(sig) = SIGNATURES.iter().find(|s| s.name == name) else {
         if !defined.contains(name) {
@@ -489,7 +488,7 @@ fn check_call(
                 } else if matches!(e, Expr::List(_)) {
                     for j in 0..6 {
                         // 1e-9 rad: the writer's 9 decimals.
-                        let [lo, hi] = JOINT_LIMITS[j];
+                        let [lo, hi] = limits[j];
                         if q[j] < lo - 1e-9 || q[j] > hi + 1e-9 {
                             problems.push(format!(
                                 "line {ln}: {name}() joint {} = {:.6} rad is beyond its limits [{lo:.4}, {hi:.4}]",
@@ -571,8 +570,19 @@ fn check_call(
     }
 }
 
-/// Lint a URScript program; `max_targets` is the per-file motion target limit.
+/// Lint a URScript program against the UR10e joint limits; `max_targets` is the per-file
+/// motion target limit.
 pub fn lint(text: &str, max_targets: usize) -> LintReport {
+    lint_with_limits(
+        text,
+        max_targets,
+        &crate::setup::JointLimitOptions::default().position(),
+    )
+}
+
+/// [`lint`] with joint position limits `limits` (rad, `[min, max]` per joint): `movej` and
+/// `servoj` joint targets outside them are rejected.
+pub fn lint_with_limits(text: &str, max_targets: usize, limits: &[[f64; 2]; 6]) -> LintReport {
     let mut rep = LintReport::default();
     let mut problems = Vec::new();
     // Pass 1: the functions the file defines.
@@ -707,7 +717,7 @@ pub fn lint(text: &str, max_targets: usize) -> LintReport {
             if MOTION.contains(&name.as_str()) {
                 rep.targets += 1;
             }
-            check_call(name, args, &defined, &mut problems, ln);
+            check_call(name, args, &defined, &mut problems, ln, limits);
         }
     }
     for (kind, ln) in &stack {

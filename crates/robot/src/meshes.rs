@@ -208,8 +208,26 @@ pub struct MeshReport {
     pub meshes: ModelClearance,
     /// The nozzle (a capsule in both models, clipped near the tip) to the environment.
     pub nozzle: ClearanceAt,
+    /// Certified smallest clearances of the meshes between the waypoints (joint-interpolated
+    /// print moves and layer changes; [`crate::sweep`]), when measured.
+    #[serde(default)]
+    pub along_motion: Option<AlongMotion>,
     /// Mesh contacts (distance 0 to the environment or on a self pair).
     pub problems: Vec<String>,
+}
+
+/// Certified lower bounds of the mesh model's clearances along the whole motion (the layer
+/// where each occurs; `index` and `what` are not resolved for a bound).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AlongMotion {
+    /// Arm meshes (links 1–6) to the environment, capped at [`MESH_CUTOFF`].
+    pub environment: ClearanceAt,
+    /// The nozzle capsules to the environment.
+    pub nozzle: ClearanceAt,
+    /// The 13 self pairs on the meshes.
+    pub self_distance: ClearanceAt,
+    /// Configurations measured (waypoints and midpoints added by the splits).
+    pub configurations: usize,
 }
 
 #[derive(Clone, Debug)]
@@ -234,6 +252,139 @@ fn better(a: &mut ClearanceAt, d: f64, at: (usize, i64, usize), what: &str, firs
     }
 }
 
+/// A layer's moves for the along-the-motion bound: print order, layer id, the joint path from
+/// the previous layer's end, and its waypoints' rows in the measured list (when all measured).
+type LayerPath = (usize, i64, Vec<Joints>, Option<std::ops::Range<usize>>);
+
+/// What one configuration is measured against.
+struct Probe<'a> {
+    ctx: &'a crate::plan::Context,
+    meshes: &'a ArmMeshes,
+    scene: &'a crate::collision::Scene,
+    world_from_base: Iso,
+    tool_caps: &'a [crate::collision::CapsuleSpec],
+}
+
+impl Probe<'_> {
+    /// Both models at `q`, with the layers printed before print order `o` as obstacles.
+    fn measure(&self, q: &Joints, o: usize) -> One {
+        let (ctx, meshes, scene, tool_caps) = (self.ctx, self.meshes, self.scene, self.tool_caps);
+        let world_from_base = self.world_from_base;
+        let q = *q;
+        // Capsules, as the planner and check_plan see them.
+        let env = ctx.env_model.pose(&q, &world_from_base);
+        let arm: Vec<_> = env
+            .as_slice()
+            .iter()
+            .copied()
+            .filter(|c| c.link != TOOL_LINK)
+            .collect();
+        let c = scene.clearance(&arm, o, MESH_CUTOFF);
+        let cap_env = (
+            c.distance,
+            format!("{} – {}", LINK_NAMES[c.link], c.object.unwrap_or_default()),
+        );
+        let posed = ctx.self_model.pose(&q, &Iso::IDENTITY);
+        let (ds, pair) = ctx.self_model.min_self_distance_posed(&posed);
+        let cap_self = (ds, format!("{}–{}", LINK_NAMES[pair.0], LINK_NAMES[pair.1]));
+        // Meshes: links 1–6 against the environment (the base stands on the mobile
+        // base, as in the capsule model), the clipped tool capsules as the nozzle.
+        let poses = meshes.poses(&q, &world_from_base);
+        let tool_env: Vec<_> = env
+            .as_slice()
+            .iter()
+            .copied()
+            .filter(|c| c.link == TOOL_LINK)
+            .collect();
+        let t = scene.clearance(&tool_env, o, MESH_CUTOFF);
+        let nozzle = (
+            t.distance,
+            format!("nozzle – {}", t.object.unwrap_or_default()),
+        );
+        let mut mesh_env = (MESH_CUTOFF, String::new());
+        for i in 1..7 {
+            let link: Vec<_> = env
+                .as_slice()
+                .iter()
+                .copied()
+                .filter(|c| c.link == i)
+                .collect();
+            let lower =
+                scene.clearance(&link, o, MESH_CUTOFF).distance - meshes.outside_capsules[i];
+            if lower >= mesh_env.0 {
+                continue;
+            }
+            let (d, name) = scene.shape_clearance(&poses[i], &meshes.hulls[i], o, MESH_CUTOFF);
+            if d < mesh_env.0 {
+                mesh_env = (
+                    d,
+                    format!("{} – {}", LINK_NAMES[i], name.unwrap_or_default()),
+                );
+            }
+        }
+        // Self pairs on the meshes (the nozzle as its full capsules).
+        let base_poses = meshes.poses(&q, &Iso::IDENTITY);
+        let flange = crate::kinematics::UR10E.fk(&q);
+        let mut mesh_self = (f64::INFINITY, String::new());
+        let cap_pairs = ctx.self_model.self_pair_distances(&q);
+        let mut order: Vec<(f64, usize)> = ctx
+            .self_model
+            .self_pairs
+            .iter()
+            .enumerate()
+            .map(|(p, &(a, b))| {
+                let out_b = if b == TOOL_LINK {
+                    0.0
+                } else {
+                    meshes.outside_capsules[b]
+                };
+                (cap_pairs[p] - meshes.outside_capsules[a] - out_b, p)
+            })
+            .collect();
+        order.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (lower, p) in order {
+            if lower >= mesh_self.0 {
+                break;
+            }
+            let (a, b) = ctx.self_model.self_pairs[p];
+            let d = if b == TOOL_LINK {
+                tool_caps
+                    .iter()
+                    .filter_map(|c| {
+                        let cap = Capsule::new(
+                            flange.point(DVec3::from(c.a)),
+                            flange.point(DVec3::from(c.b)),
+                            c.radius,
+                        );
+                        query::distance(&base_poses[a], &meshes.hulls[a], &Pose::IDENTITY, &cap)
+                            .ok()
+                            .map(|d| d.distance)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            } else {
+                query::distance(
+                    &base_poses[a],
+                    &meshes.hulls[a],
+                    &base_poses[b],
+                    &meshes.hulls[b],
+                )
+                .map_or(f64::INFINITY, |d| d.distance)
+            };
+            if d < mesh_self.0 {
+                mesh_self = (d, format!("{}–{}", LINK_NAMES[a], LINK_NAMES[b]));
+            }
+        }
+        One {
+            at: (0, 0, 0),
+            cap_env,
+            cap_self,
+            nozzle,
+            mesh_env,
+            mesh_self,
+        }
+    }
+}
+
 /// Verify `plan` against UR's convex collision meshes and the capsules, every `stride`-th
 /// waypoint of each layer plus each layer's first and last.
 pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotError> {
@@ -248,12 +399,41 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
         .filter(|c| c.link == TOOL_LINK)
         .cloned()
         .collect();
+    // Motion bounds of the mesh model: the hulls lie inside their capsules inflated by
+    // `outside_capsules`, the nozzle is its full capsules (crate::sweep).
+    let mut extra = [0.0; 8];
+    extra[..7].copy_from_slice(&meshes.outside_capsules);
+    let bounds = crate::sweep::SweepBounds::for_capsules(
+        &crate::kinematics::UR10E,
+        &ctx.self_model.capsules,
+        extra,
+    );
+    let self_pairs = ctx.self_model.self_pairs.clone();
+    let displacement = |tv: &[f64; 6]| -> [f64; 3] {
+        let env = (1..7).map(|k| bounds.world(tv, k)).fold(0.0, f64::max);
+        let slf = self_pairs
+            .iter()
+            .map(|&(a, b)| bounds.relative(tv, a, b))
+            .fold(0.0, f64::max);
+        [env, bounds.world(tv, TOOL_LINK), slf]
+    };
+    let mut along = AlongMotion::default();
+    let mut along_min = [(f64::INFINITY, 0usize, 0i64); 3];
+    let mut along_problems: Vec<String> = Vec::new();
     let mut out: Vec<One> = Vec::new();
     let mut order = 0usize;
     for (si, st) in plan.stations.iter().enumerate() {
         let world_from_base = Iso::from_mat4(&st.world_from_base)
             .map_err(|e| RobotError::invalid(format!("station {si} world_from_base"), e))?;
         let scene = ctx.scene(&world_from_base)?;
+        let probe = Probe {
+            ctx: &ctx,
+            meshes: &meshes,
+            scene: &scene,
+            world_from_base,
+            tool_caps: &tool_caps,
+        };
+        let first_order = order;
         let mut jobs: Vec<(usize, i64, usize, Joints)> = Vec::new();
         for l in &st.layers {
             let n = l.waypoints.len();
@@ -267,130 +447,106 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
         let res: Vec<One> = jobs
             .par_iter()
             .map(|&(o, layer, index, q)| {
-                // Capsules, as the planner and check_plan see them.
-                let env = ctx.env_model.pose(&q, &world_from_base);
-                let arm: Vec<_> = env
-                    .as_slice()
-                    .iter()
-                    .copied()
-                    .filter(|c| c.link != TOOL_LINK)
-                    .collect();
-                let c = scene.clearance(&arm, o, MESH_CUTOFF);
-                let cap_env = (
-                    c.distance,
-                    format!("{} – {}", LINK_NAMES[c.link], c.object.unwrap_or_default()),
-                );
-                let posed = ctx.self_model.pose(&q, &Iso::IDENTITY);
-                let (ds, pair) = ctx.self_model.min_self_distance_posed(&posed);
-                let cap_self = (ds, format!("{}–{}", LINK_NAMES[pair.0], LINK_NAMES[pair.1]));
-                // Meshes: links 1–6 against the environment (the base stands on the mobile
-                // base, as in the capsule model), the clipped tool capsules as the nozzle.
-                let poses = meshes.poses(&q, &world_from_base);
-                let tool_env: Vec<_> = env
-                    .as_slice()
-                    .iter()
-                    .copied()
-                    .filter(|c| c.link == TOOL_LINK)
-                    .collect();
-                let t = scene.clearance(&tool_env, o, MESH_CUTOFF);
-                let nozzle = (
-                    t.distance,
-                    format!("nozzle – {}", t.object.unwrap_or_default()),
-                );
-                let mut mesh_env = (MESH_CUTOFF, String::new());
-                for i in 1..7 {
-                    let link: Vec<_> = env
-                        .as_slice()
-                        .iter()
-                        .copied()
-                        .filter(|c| c.link == i)
-                        .collect();
-                    let lower = scene.clearance(&link, o, MESH_CUTOFF).distance
-                        - meshes.outside_capsules[i];
-                    if lower >= mesh_env.0 {
-                        continue;
-                    }
-                    let (d, name) =
-                        scene.shape_clearance(&poses[i], &meshes.hulls[i], o, MESH_CUTOFF);
-                    if d < mesh_env.0 {
-                        mesh_env = (
-                            d,
-                            format!("{} – {}", LINK_NAMES[i], name.unwrap_or_default()),
-                        );
-                    }
-                }
-                // Self pairs on the meshes (the nozzle as its full capsules).
-                let base_poses = meshes.poses(&q, &Iso::IDENTITY);
-                let flange = crate::kinematics::UR10E.fk(&q);
-                let mut mesh_self = (f64::INFINITY, String::new());
-                let cap_pairs = ctx.self_model.self_pair_distances(&q);
-                let mut order: Vec<(f64, usize)> = ctx
-                    .self_model
-                    .self_pairs
-                    .iter()
-                    .enumerate()
-                    .map(|(p, &(a, b))| {
-                        let out_b = if b == TOOL_LINK {
-                            0.0
-                        } else {
-                            meshes.outside_capsules[b]
-                        };
-                        (cap_pairs[p] - meshes.outside_capsules[a] - out_b, p)
-                    })
-                    .collect();
-                order.sort_by(|x, y| x.0.total_cmp(&y.0));
-                for (lower, p) in order {
-                    if lower >= mesh_self.0 {
-                        break;
-                    }
-                    let (a, b) = ctx.self_model.self_pairs[p];
-                    let d = if b == TOOL_LINK {
-                        tool_caps
-                            .iter()
-                            .filter_map(|c| {
-                                let cap = Capsule::new(
-                                    flange.point(DVec3::from(c.a)),
-                                    flange.point(DVec3::from(c.b)),
-                                    c.radius,
-                                );
-                                query::distance(
-                                    &base_poses[a],
-                                    &meshes.hulls[a],
-                                    &Pose::IDENTITY,
-                                    &cap,
-                                )
-                                .ok()
-                                .map(|d| d.distance)
-                            })
-                            .fold(f64::INFINITY, f64::min)
-                    } else {
-                        query::distance(
-                            &base_poses[a],
-                            &meshes.hulls[a],
-                            &base_poses[b],
-                            &meshes.hulls[b],
-                        )
-                        .map_or(f64::INFINITY, |d| d.distance)
-                    };
-                    if d < mesh_self.0 {
-                        mesh_self = (d, format!("{}–{}", LINK_NAMES[a], LINK_NAMES[b]));
-                    }
-                }
-                One {
-                    at: (si, layer, index),
-                    cap_env,
-                    cap_self,
-                    nozzle,
-                    mesh_env,
-                    mesh_self,
-                }
+                let mut one = probe.measure(&q, o);
+                one.at = (si, layer, index);
+                one
             })
             .collect();
+        let station_rows = out.len();
         out.extend(res);
+        // Along the motion: each layer's moves from the previous layer's end (crate::sweep),
+        // split where a bound is below the planner's margins (contact is the failure).
+        // With every waypoint measured above (stride 1), a layer's rows are reused; only the
+        // previous layer's end is measured again, with this layer's obstacles.
+        let mut paths: Vec<LayerPath> = Vec::new();
+        let mut prev: Option<Joints> = None;
+        let mut row = station_rows;
+        for (k, l) in st.layers.iter().enumerate() {
+            let path: Vec<Joints> = prev
+                .into_iter()
+                .chain(l.waypoints.iter().map(|w| w.q))
+                .collect();
+            prev = l.waypoints.last().map(|w| w.q);
+            let rows = (stride == 1).then(|| row..row + l.waypoints.len());
+            row += l.waypoints.len();
+            paths.push((first_order + k, l.layer, path, rows));
+        }
+        let required = [
+            plan.options.clearance,
+            plan.options.clearance,
+            plan.options.self_clearance,
+        ];
+        // A mesh fails only on contact (0 = touching).
+        let contact = [0.0; 3];
+        let certified: Vec<(i64, [f64; 3], usize)> = paths
+            .par_iter()
+            .map(|(o, layer, path, rows)| {
+                let measure = |q: &Joints| {
+                    let m = probe.measure(q, *o);
+                    [m.mesh_env.0, m.nozzle.0, m.mesh_self.0]
+                };
+                let Some(rows) = rows.clone().filter(|r| r.end <= out.len()) else {
+                    let (lb, n) = crate::sweep::certify(
+                        path,
+                        &measure,
+                        &displacement,
+                        required,
+                        contact,
+                        None,
+                    );
+                    return (*layer, lb, n);
+                };
+                let skip = path.len() - rows.len();
+                let measured: Vec<[f64; 3]> = path[..skip]
+                    .iter()
+                    .map(measure)
+                    .chain(
+                        out[rows]
+                            .iter()
+                            .map(|m| [m.mesh_env.0, m.nozzle.0, m.mesh_self.0]),
+                    )
+                    .collect();
+                let (lb, n) = crate::sweep::certify_measured(
+                    path,
+                    &measured,
+                    &measure,
+                    &displacement,
+                    required,
+                    contact,
+                    None,
+                );
+                (*layer, lb, n + measured.len())
+            })
+            .collect();
+        for (layer, lb, n) in certified {
+            along.configurations += n;
+            for (c, v) in lb.iter().enumerate() {
+                if *v < along_min[c].0 {
+                    along_min[c] = (*v, si, layer);
+                }
+            }
+            if lb.iter().any(|v| *v <= 0.0) && along_problems.len() < 20 {
+                along_problems.push(format!(
+                    "station {si} layer {layer}: between the waypoints the collision meshes may touch (certified clearance to the environment {:.4} m, nozzle {:.4} m, self {:.4} m)",
+                    lb[0], lb[1], lb[2]
+                ));
+            }
+        }
     }
+    let at = |c: usize| ClearanceAt {
+        distance: along_min[c].0,
+        station: along_min[c].1,
+        layer: along_min[c].2,
+        index: 0,
+        what: String::new(),
+    };
+    along.environment = at(0);
+    along.nozzle = at(1);
+    along.self_distance = at(2);
     let mut rep = MeshReport {
         waypoints_checked: out.len(),
         mesh_vertices: meshes.vertices.clone(),
+        along_motion: Some(along),
         ..Default::default()
     };
     for (k, o) in out.iter().enumerate() {
@@ -437,6 +593,7 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
             ));
         }
     }
+    rep.problems.extend(along_problems);
     Ok(rep)
 }
 

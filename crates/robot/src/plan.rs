@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use crate::collision::{CapsuleSpec, LINK_NAMES, Obstacle, RobotModel, Scene, TOOL_LINK};
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, Mat4, frame_from_z};
-use crate::kinematics::{JOINT_LIMITS, Joints, UR10E, joint_delta, within_limits};
+use crate::kinematics::{Joints, UR10E, joint_delta, representable_in_limits};
 use crate::ladder::{LadderFailure, solve_optimal, solve_random};
 use crate::setup::{BasePlacement, PlanOptions, PlannerKind, PrintLayer, RobotSetup};
 
@@ -80,7 +80,11 @@ pub struct Plan {
     pub joint_motion: f64,
     /// Time spent printing (s).
     pub print_time: f64,
-    /// Time from the first to the last waypoint, transitions and station changes included (s).
+    /// The plan's clock at the arrival at the last target (s). The clock starts (0) when the
+    /// first program starts its approach from the safe pose and counts every approach,
+    /// priming, print move, pause, program change and station change; every waypoint's `t`,
+    /// trajectory.csv's `t`, [`crate::layer_times`] and programs.json's `start_s`/`end_s` are
+    /// on it, so this is also the end of the last layer. The final retract comes after it.
     pub total_time: f64,
     /// Smallest clearance to the environment over all waypoints (m, capped at 0.5).
     pub min_clearance: f64,
@@ -101,9 +105,42 @@ pub struct Plan {
     /// ([`crate::meshes::attach_mesh_report`]).
     #[serde(default)]
     pub meshes: Option<crate::meshes::MeshReport>,
+    /// Certified capsule clearances along the motion from the plan's check
+    /// ([`crate::check::CheckReport`]), when checked.
+    #[serde(default)]
+    pub certified: Option<CertifiedClearance>,
     /// The setup (with the base placement resolved to the stations) and options used.
     pub setup: RobotSetup,
     pub options: PlanOptions,
+}
+
+/// Certified lower bounds of the capsule model's clearances along the whole motion (print moves,
+/// layer changes, station approaches and retracts; [`crate::sweep`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CertifiedClearance {
+    /// To the environment along the print moves and layer changes (m, capped at 0.5), which
+    /// hold the planner's margin.
+    pub clearance: f64,
+    /// To the environment along the station approaches and retracts, which need only be clear
+    /// of contact (m).
+    #[serde(default)]
+    pub approach_clearance: f64,
+    /// Of the checked self pairs (m).
+    pub self_distance: f64,
+    /// Configurations measured (waypoints and added midpoints).
+    pub configurations: usize,
+}
+
+impl CertifiedClearance {
+    /// The certified values of a check report.
+    pub fn of(rep: &crate::check::CheckReport) -> Self {
+        CertifiedClearance {
+            clearance: rep.certified_clearance,
+            approach_clearance: rep.certified_approach_clearance,
+            self_distance: rep.certified_self_distance,
+            configurations: rep.certified_configurations,
+        }
+    }
 }
 
 impl Plan {
@@ -127,6 +164,8 @@ pub(crate) struct Context {
     pub opts: PlanOptions,
     pub setup: RobotSetup,
     pub layers: Vec<PrintLayer>,
+    /// Joint position limits (rad), validated.
+    pub limits: [[f64; 2]; 6],
 }
 
 /// Clip a tool capsule to the part at least `excl` behind the tip along the tool axis.
@@ -240,6 +279,7 @@ pub(crate) fn validate(
             format!("{:?}: must be finite", pr.payload_cog),
         ));
     }
+    opts.limits.validate_positions()?;
     for j in 0..6 {
         let (v, a) = (
             opts.limits.max_speed_deg_s[j],
@@ -355,6 +395,7 @@ pub(crate) fn validate(
         opts: opts.clone(),
         setup: setup.clone(),
         layers: cleaned,
+        limits: opts.limits.position(),
     })
 }
 
@@ -439,6 +480,50 @@ impl Context {
         world_tcp: &Iso,
         order: usize,
     ) -> (Vec<Vertex>, Rejections) {
+        self.vertices_upto(
+            scene,
+            base_from_world,
+            world_from_base,
+            world_tcp,
+            order,
+            usize::MAX,
+        )
+    }
+
+    /// Whether a world TCP frame has any valid vertex ([`Self::vertices`] is non-empty): stops at
+    /// the first one and measures clearances only up to the required clearance (a vertex is
+    /// valid iff its clearance capped at any cutoff ≥ `clearance` is ≥ `clearance`), so the base
+    /// search's scoring does a fraction of the distance queries.
+    pub fn has_vertex(
+        &self,
+        scene: &Scene,
+        base_from_world: &Iso,
+        world_from_base: &Iso,
+        world_tcp: &Iso,
+        order: usize,
+    ) -> bool {
+        !self
+            .vertices_upto(scene, base_from_world, world_from_base, world_tcp, order, 1)
+            .0
+            .is_empty()
+    }
+
+    /// The valid vertices, at most `max` of them; with `max < usize::MAX` clearances are
+    /// measured only up to the required clearance (see [`Self::has_vertex`]).
+    fn vertices_upto(
+        &self,
+        scene: &Scene,
+        base_from_world: &Iso,
+        world_from_base: &Iso,
+        world_tcp: &Iso,
+        order: usize,
+        max: usize,
+    ) -> (Vec<Vertex>, Rejections) {
+        let cutoff = if max == usize::MAX {
+            CLEARANCE_CUTOFF
+        } else {
+            self.opts.clearance.min(CLEARANCE_CUTOFF)
+        };
         let mut rej = Rejections::default();
         let mut out = Vec::new();
         let n_rot = if self.coaxial {
@@ -457,7 +542,7 @@ impl Context {
                 if self.coaxial {
                     q[5] = self.opts.q6;
                 }
-                if !within_limits(&q, &JOINT_LIMITS) {
+                if !representable_in_limits(&q, &self.limits) {
                     rej.limits += 1;
                     continue;
                 }
@@ -473,7 +558,7 @@ impl Context {
                     continue;
                 }
                 let env = self.env_model.pose(&q, world_from_base);
-                let c = scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
+                let c = scene.clearance(env.as_slice(), order, cutoff);
                 if c.distance < self.opts.clearance {
                     rej.collision += 1;
                     if rej.collision_example.is_none() {
@@ -486,6 +571,9 @@ impl Context {
                     q,
                     clearance: c.distance,
                 });
+                if out.len() >= max {
+                    return (out, rej);
+                }
             }
         }
         (out, rej)
@@ -769,7 +857,7 @@ pub(crate) fn plan_station_cached(
         let mut best: Option<f64> = None;
         for m in -3i32..=3 {
             let s = f64::from(m) * tau;
-            if lo + s >= JOINT_LIMITS[j][0] - 1e-12 && hi + s <= JOINT_LIMITS[j][1] + 1e-12 {
+            if lo + s >= ctx.limits[j][0] - 1e-12 && hi + s <= ctx.limits[j][1] + 1e-12 {
                 let better = best.is_none_or(|b| (mid + s).abs() < (mid + b).abs());
                 if better {
                     best = Some(s);
@@ -785,7 +873,7 @@ pub(crate) fn plan_station_cached(
                 format!(
                     "joint {} travels from {lo:.3} to {hi:.3} rad, more than its range {:?}",
                     j + 1,
-                    JOINT_LIMITS[j]
+                    ctx.limits[j]
                 ),
             ));
         };
@@ -925,6 +1013,7 @@ pub fn plan_print_with_waits(
     if !report.problems.is_empty() {
         return Err(RobotError::Verification(report.problems));
     }
+    plan.certified = Some(CertifiedClearance::of(&report));
     Ok(plan)
 }
 
@@ -972,6 +1061,7 @@ fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
         slowdowns: Vec::new(),
         parts: Vec::new(),
         meshes: None,
+        certified: None,
         setup,
         options: ctx.opts.clone(),
         stations,

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::RobotError;
 use crate::frames::Iso;
-use crate::kinematics::{JOINT_LIMITS, Joints, UR10E, joint_delta, within_limits};
+use crate::kinematics::{Joints, UR10E, joint_delta, within_limits};
 use crate::plan::Plan;
 use crate::setup::{AnalogDomain, PauseMode};
 
@@ -44,54 +44,122 @@ fn part_targets(points: usize, starts: bool, ends: bool) -> usize {
     body + usize::from(ends)
 }
 
-/// Cut the plan into program parts: whole layers, at most `max_moves_per_program` targets each.
+/// Layer ranges `first..end` of a station's files filled greedily up to `cap` targets each;
+/// `Err(slot)` names a layer that does not fit in one file.
+fn fill(sizes: &[usize], cap: usize) -> Result<Vec<(usize, usize)>, usize> {
+    let n = sizes.len();
+    let mut out = Vec::new();
+    let mut first = 0usize;
+    while first < n {
+        let starts = first == 0;
+        let (mut end, mut points) = (first, 0usize);
+        while end < n {
+            let p = points + sizes[end];
+            if part_targets(p, starts, end + 1 == n) > cap {
+                break;
+            }
+            points = p;
+            end += 1;
+        }
+        if end == first {
+            return Err(first);
+        }
+        out.push((first, end));
+        first = end;
+    }
+    Ok(out)
+}
+
+/// Among the cuts of `sizes` into exactly `k` files of at most `cap` targets, one whose
+/// smallest file is largest (DP over the cut points, O(k·n²)); None if there is none.
+fn widest_smallest(sizes: &[usize], k: usize, cap: usize) -> Option<Vec<(usize, usize)>> {
+    let n = sizes.len();
+    let mut pre = vec![0usize; n + 1];
+    for (i, s) in sizes.iter().enumerate() {
+        pre[i + 1] = pre[i] + s;
+    }
+    let cost = |a: usize, b: usize| part_targets(pre[b] - pre[a], a == 0, b == n);
+    // best[j][b]: the largest smallest file cutting layers 0..b into j files; from[j][b] the
+    // start of the last of them.
+    let mut best = vec![vec![None::<usize>; n + 1]; k + 1];
+    let mut from = vec![vec![0usize; n + 1]; k + 1];
+    best[0][0] = Some(usize::MAX);
+    for j in 1..=k {
+        for b in j..=n {
+            for a in (j - 1)..b {
+                let Some(prev) = best[j - 1][a] else { continue };
+                let c = cost(a, b);
+                if c > cap {
+                    continue;
+                }
+                let v = prev.min(c);
+                if best[j][b].is_none_or(|x| v > x) {
+                    best[j][b] = Some(v);
+                    from[j][b] = a;
+                }
+            }
+        }
+    }
+    best[k][n]?;
+    let mut cut = Vec::with_capacity(k);
+    let mut b = n;
+    for j in (1..=k).rev() {
+        let a = from[j][b];
+        cut.push((a, b));
+        b = a;
+    }
+    cut.reverse();
+    Some(cut)
+}
+
+/// Cut the plan into program parts: whole layers, at most `max_moves_per_program` targets each,
+/// in the fewest files per station, balanced (linear partition): among the cuts into that many
+/// files, the largest file is as small as possible, and then the smallest as large as possible
+/// (so no station ends with a small file when an even cut exists). Greedy filling up to a cap
+/// C gives the fewest files for C, and that count only falls as C grows, so the smallest C that
+/// needs no more files than the limit does is found by bisection; a DP then picks, among the
+/// cuts within C, the one with the largest smallest file.
 pub fn split_parts(plan: &Plan) -> Result<Vec<ProgramPart>, RobotError> {
     let max = plan.options.program.max_moves_per_program;
     let mut parts = Vec::new();
     for (si, st) in plan.stations.iter().enumerate() {
-        let n = st.layers.len();
-        let mut first = 0usize;
-        while first < n {
-            let mut last = first;
-            let mut points = 0usize;
-            let starts = first == 0;
-            loop {
-                let p = points + st.layers[last].waypoints.len();
-                if part_targets(p, starts, last + 1 == n) > max {
-                    break;
-                }
-                points = p;
-                if last + 1 == n {
-                    last += 1;
-                    break;
-                }
-                last += 1;
+        let sizes: Vec<usize> = st.layers.iter().map(|l| l.waypoints.len()).collect();
+        let fewest = fill(&sizes, max).map_err(|slot| {
+            let l = &st.layers[slot];
+            let need = part_targets(l.waypoints.len(), true, true);
+            RobotError::invalid(
+                "program.max_moves_per_program",
+                format!(
+                    "{max} targets per program is below what layer {} needs ({} points + {} approach/retract moves); raise it to at least {need}",
+                    l.layer,
+                    l.waypoints.len(),
+                    need - l.waypoints.len(),
+                ),
+            )
+        })?;
+        // fill(max) succeeded, so the smallest feasible cap lies in (lo, hi].
+        let (mut lo, mut hi) = (0usize, max);
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match fill(&sizes, mid) {
+                Ok(c) if c.len() <= fewest.len() => hi = mid,
+                _ => lo = mid,
             }
-            if last == first {
-                let l = &st.layers[first];
-                return Err(RobotError::invalid(
-                    "program.max_moves_per_program",
-                    format!(
-                        "{max} targets per program is below what layer {} needs ({} points + {} approach/retract moves); raise it to at least {}",
-                        l.layer,
-                        l.waypoints.len(),
-                        part_targets(l.waypoints.len(), true, true) - l.waypoints.len(),
-                        part_targets(l.waypoints.len(), true, true)
-                    ),
-                ));
-            }
-            let lastslot = last - 1;
+        }
+        let cut = widest_smallest(&sizes, fewest.len(), hi).unwrap_or(fewest);
+        let n = sizes.len();
+        for (first, end) in cut {
+            let points: usize = sizes[first..end].iter().sum();
             parts.push(ProgramPart {
                 station: si,
                 first,
-                last: lastslot,
+                last: end - 1,
                 first_layer: st.layers[first].layer,
-                last_layer: st.layers[lastslot].layer,
-                targets: part_targets(points, starts, last == n),
-                starts_station: starts,
-                ends_station: last == n,
+                last_layer: st.layers[end - 1].layer,
+                targets: part_targets(points, first == 0, end == n),
+                starts_station: first == 0,
+                ends_station: end == n,
             });
-            first = last;
         }
     }
     Ok(parts)
@@ -122,7 +190,12 @@ fn num(x: f64) -> String {
 
 /// The safe approach configuration: the first target backed off `dist` along the tool axis,
 /// the IK solution nearest `q` (same branch), unwrapped next to `q`.
-pub(crate) fn approach_config(q: &Joints, tool: &Iso, dist: f64) -> Result<Joints, RobotError> {
+pub(crate) fn approach_config(
+    q: &Joints,
+    tool: &Iso,
+    dist: f64,
+    limits: &[[f64; 2]; 6],
+) -> Result<Joints, RobotError> {
     let tcp = UR10E.fk(q).mul(tool);
     let back = tcp.mul(&Iso::translation(0.0, 0.0, -dist));
     let flange = back.mul(&tool.inverse());
@@ -131,7 +204,7 @@ pub(crate) fn approach_config(q: &Joints, tool: &Iso, dist: f64) -> Result<Joint
     for s in sols.as_slice() {
         let d = joint_delta(q, s);
         let cand: Joints = std::array::from_fn(|j| q[j] + d[j]);
-        if !within_limits(&cand, &JOINT_LIMITS) {
+        if !within_limits(&cand, limits) {
             continue;
         }
         let c: f64 = d.iter().map(|v| v * v).sum();
@@ -232,7 +305,12 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
             if let Some(s) = enable(false) {
                 line(&s);
             }
-            let qa = approach_config(&first_wp.q, &tool, pr.approach_distance)?;
+            let qa = approach_config(
+                &first_wp.q,
+                &tool,
+                pr.approach_distance,
+                &plan.options.limits.position(),
+            )?;
             line(&format!(
                 "# approach: safe pose {} m behind the first target, then down to it",
                 num(pr.approach_distance)

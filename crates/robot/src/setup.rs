@@ -273,8 +273,7 @@ impl Default for PlanOptions {
     }
 }
 
-/// Joint speed and acceleration limits (UR10e defaults). Position limits are UR's (±360°, the
-/// elbow ±180°: [`crate::kinematics::JOINT_LIMITS`]).
+/// Joint position, speed and acceleration limits (UR10e defaults).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct JointLimitOptions {
@@ -284,18 +283,56 @@ pub struct JointLimitOptions {
     /// 5 rad/s² is the conservative value of UR's own MoveIt configuration
     /// (`ur_moveit_config/config/joint_limits.yaml`).
     pub max_acceleration: [f64; 6],
+    /// Joint position limits `[min, max]` (°), used by the planner, the check and the program
+    /// lint. UR10e: ±360° on every joint (the controller's range, UR10e manual), the elbow ±180°
+    /// (the arm's own structure blocks it beyond about ±180°; UR's ROS description halves it
+    /// for that reason; robot.md §1.1). Allowed: finite, min < max, within ±360°.
+    pub position_deg: [[f64; 2]; 6],
 }
+
+/// UR10e joint position limits (°), see [`JointLimitOptions::position_deg`].
+pub const UR10E_POSITION_DEG: [[f64; 2]; 6] = [
+    [-360.0, 360.0],
+    [-360.0, 360.0],
+    [-180.0, 180.0],
+    [-360.0, 360.0],
+    [-360.0, 360.0],
+    [-360.0, 360.0],
+];
 
 impl Default for JointLimitOptions {
     fn default() -> Self {
         JointLimitOptions {
             max_speed_deg_s: [120.0, 120.0, 180.0, 180.0, 180.0, 180.0],
             max_acceleration: [5.0; 6],
+            position_deg: UR10E_POSITION_DEG,
         }
     }
 }
 
 impl JointLimitOptions {
+    /// Position limits in rad.
+    pub fn position(&self) -> [[f64; 2]; 6] {
+        self.position_deg.map(|r| r.map(f64::to_radians))
+    }
+
+    /// Check the position limits: finite, min < max, within ±360° (the controller's range);
+    /// [`RobotError::JointPositionLimit`] names the first bad joint.
+    pub fn validate_positions(&self) -> Result<(), crate::error::RobotError> {
+        for (j, &[min, max]) in self.position_deg.iter().enumerate() {
+            let ok =
+                min.is_finite() && max.is_finite() && min < max && min >= -360.0 && max <= 360.0;
+            if !ok {
+                return Err(crate::error::RobotError::JointPositionLimit {
+                    joint: j + 1,
+                    min,
+                    max,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Speed limits in rad/s.
     pub fn max_speed(&self) -> [f64; 6] {
         self.max_speed_deg_s.map(f64::to_radians)

@@ -100,6 +100,7 @@ pub fn retime(plan: &Plan, waits: &[LayerWait]) -> Result<Plan, RobotError> {
     if !rep.problems.is_empty() {
         return Err(RobotError::Verification(rep.problems));
     }
+    p.certified = Some(crate::plan::CertifiedClearance::of(&rep));
     Ok(p)
 }
 
@@ -459,19 +460,16 @@ fn time_all(plan: &mut Plan, vmax: &[f64; 6], amax: &[f64; 6]) -> Result<(), Rob
     plan.print_time = print_time;
     plan.max_speed_ratio = max_v;
     plan.max_acceleration_ratio = max_a;
-    let first = plan
-        .stations
-        .first()
-        .and_then(|s| s.layers.first())
-        .and_then(|l| l.waypoints.first())
-        .map_or(0.0, |w| w.t);
+    // One clock: 0 is the start of the first program (its approach from the safe pose), so the
+    // total is the arrival at the last target, which is also the end of the last layer in
+    // `layer_times` and the last row of trajectory.csv (the final retract comes after it).
     let last = plan
         .stations
         .last()
         .and_then(|s| s.layers.last())
         .and_then(|l| l.waypoints.last())
         .map_or(0.0, |w| w.t);
-    plan.total_time = last - first;
+    plan.total_time = last;
     for st in &mut plan.stations {
         for l in &mut st.layers {
             let mut m = 0.0f64;

@@ -58,19 +58,11 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
     };
     let result = kappe::buildability::run(&resolved, &|_| bar.inc(1))?;
     bar.finish_and_clear();
-    let doc = serde_json::json!({
-        "format": "kappe.buildability",
-        "version": 1,
-        "spec": resolved.spec,
-        "failure_layer": result.failure_layer,
-        "failure_mode": result.failure_mode,
-        "result": result,
-    });
-    let json = serde_json::to_string_pretty(&doc)? + "\n";
+    let json =
+        serde_json::to_string_pretty(&kappe::buildability::document(&resolved, &result))? + "\n";
     if let Some(prepared) = prepared {
         let dir = prepared.path();
-        let mut schedule = resolved.schedule.clone();
-        schedule.layers.truncate(result.states.len());
+        let schedule = kappe::buildability::checked_schedule(&resolved, &result);
         write_file_atomic(&dir.join("buildability.json"), json.as_bytes())?;
         write_file_atomic(&dir.join("schedule.csv"), schedule.to_csv().as_bytes())?;
         if let Some(notice) = prepared.commit()? {
@@ -79,51 +71,11 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
     }
     if args.json {
         print!("{json}");
-        return Ok(ExitCode::SUCCESS);
-    }
-    let o = &resolved.spec.object;
-    println!(
-        "{} {:?}: {} layers of {:.1} mm, {:.2} s per layer, {} elements along the centre line",
-        if resolved.spec.name.is_empty() {
-            "buildability"
-        } else {
-            &resolved.spec.name
-        },
-        o.kind,
-        result.states.len(),
-        o.layer_height * 1e3,
-        result.layer_time_s,
-        result.segments
-    );
-    println!(
-        "  {:>5} {:>8} {:>9} {:>10} {:>9} {:>9}  governs",
-        "n", "H [m]", "age0 [s]", "BLF", "strength", "sliding"
-    );
-    let f = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
-    let step = (result.states.len() / 20).max(1);
-    for s in &result.states {
-        if s.layers % step == 0 || s.failure.is_some() || s.layers == 1 {
-            println!(
-                "  {:>5} {:>8.3} {:>9.1} {:>10} {:>9} {:>9}  {}",
-                s.layers,
-                s.height_m,
-                s.bottom_age_s,
-                f(s.blf),
-                f(s.strength_utilisation),
-                f(s.sliding_utilisation),
-                s.governing.map_or("-", |m| m.name())
-            );
-        }
-    }
-    match (result.failure_layer, result.failure_mode) {
-        (Some(n), Some(m)) => println!("fails at layer {n} by {}", m.name()),
-        _ => println!("stands to {max} layers"),
-    }
-    if let Some(n) = result.plastic_collapse_estimate {
-        println!("  (closed-form uniaxial plastic collapse at the base: layer {n})");
-    }
-    if let Some(out) = &args.out {
-        println!("wrote {}", out.display());
+    } else {
+        print!(
+            "{}",
+            kappe::buildability::text_report(&resolved, &result, args.out.as_deref())
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

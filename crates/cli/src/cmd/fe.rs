@@ -7,9 +7,9 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use kappe_fe::mesh_json::parse_mesh;
-use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, ShellModel, StaticResult};
-use serde_json::{Value, json};
+use kappe_fe::summary;
+use kappe_fe::{BucklingOptions, BucklingSolver, ElementKind, ShellModel};
+use serde_json::Value;
 
 use crate::exit::Usage;
 use crate::output::{check_user_file, write_user_file};
@@ -107,54 +107,22 @@ fn load(
     allow_mixed_orientation: bool,
     element: Option<ElementArg>,
 ) -> Result<ShellModel> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut model =
-        parse_mesh(&text).with_context(|| format!("invalid mesh in {}", path.display()))?;
-    model.allow_mixed_orientation |= allow_mixed_orientation;
-    // The mesh file's own default is the fixtures' reference element (CST+DKT), so old files
-    // keep their meaning inside the library; the command's default is the shear-deformable
-    // element, which is at least as accurate on thin shells and right on thick ones (issue 17).
-    let names_element = serde_json::from_str::<Value>(&text)
-        .ok()
-        .is_some_and(|v| v.get("element").is_some());
-    match element {
-        Some(e) => model.element = e.into(),
-        None if !names_element => model.element = ElementKind::AndesDkmt,
-        None => {}
-    }
-    Ok(model)
+    Ok(summary::read_mesh_file(
+        path,
+        allow_mixed_orientation,
+        element.map(Into::into),
+    )?)
 }
 
 fn emit(output: Option<&Path>, force: bool, doc: &Value) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(doc).context("cannot serialize the result")?;
-    text.push('\n');
+    let text = summary::document(doc).context("cannot serialize the result")?;
     match output {
-        Some(out) => write_user_file(out, text.as_bytes(), force),
+        Some(out) => Ok(write_user_file(out, text.as_bytes(), force)?),
         None => {
             print!("{text}");
             Ok(())
         }
     }
-}
-
-/// Flat triangles (aspect > 20) are solved but flagged, with the worst few named.
-fn quality(model: &ShellModel) -> Value {
-    let mut w = model.quality_warnings();
-    w.sort_by(|a, b| b.1.total_cmp(&a.1));
-    json!({
-        "flat_triangles": w.len(),
-        "aspect_limit": kappe_fe::model::WARN_ASPECT,
-        "worst": w.iter().take(10).map(|(e, a)| json!({"element": e, "aspect": a})).collect::<Vec<_>>(),
-    })
-}
-
-fn static_summary(s: &StaticResult) -> Value {
-    json!({
-        "max_displacement": s.max_displacement,
-        "reactions_sum": s.reactions_sum,
-        "load_sum": s.load_sum,
-    })
 }
 
 fn buckle(args: BuckleArgs) -> Result<ExitCode> {
@@ -174,8 +142,7 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
         .buckling(&model, &options)
         .with_context(|| format!("buckling analysis of {source} failed"))?;
     let time_s = t0.elapsed().as_secs_f64();
-    if r.static_result.load_sum.iter().all(|v| *v == 0.0) && r.static_result.max_displacement == 0.0
-    {
+    if !summary::has_load(&r.static_result) {
         return Err(Usage(format!(
             "{source} has no load (gamma = 0 and no nodal loads): there is nothing to buckle"
         ))
@@ -187,36 +154,7 @@ fn buckle(args: BuckleArgs) -> Result<ExitCode> {
              compression (reversing the load may buckle it)"
         );
     }
-    let s = &r.stats;
-    let mut doc = json!({
-        "factors": r.factors,
-        "static": static_summary(&r.static_result),
-        "dofs": s.n_free_dofs,
-        "time_s": time_s,
-        "residuals": r.residuals,
-        "mesh_quality": quality(&model),
-        "sturm": r.sturm.map(|c| json!({
-            "sigma": c.sigma,
-            "negative_pivots": c.negative_pivots,
-            "factors_below_sigma": c.found_below,
-        })),
-        "solver": {
-            "element": model.element.description(),
-            "element_kind": model.element.name(),
-            "nnz_k": s.nnz_k,
-            "nnz_l": s.nnz_l,
-            "operator_applications": s.operator_applications,
-            "t_symbolic_s": s.t_symbolic,
-            "t_assembly_s": s.t_assembly,
-            "t_factor_s": s.t_factor,
-            "t_geometric_s": s.t_geometric,
-            "t_eigen_s": s.t_eigen,
-            "t_sturm_s": s.t_sturm,
-        },
-    });
-    if args.mode_shapes {
-        doc["modes"] = json!(r.modes);
-    }
+    let doc = summary::buckle_value(&model, &r, time_s, args.mode_shapes);
     emit(args.output.as_deref(), args.force, &doc)?;
     Ok(ExitCode::SUCCESS)
 }
@@ -230,38 +168,7 @@ fn statics(args: StaticArgs) -> Result<ExitCode> {
     let source = args.mesh.display().to_string();
     let r = kappe_fe::linear_static(&model)
         .with_context(|| format!("static analysis of {source} failed"))?;
-    let elements: Vec<Value> = r
-        .elements
-        .iter()
-        .map(|e| {
-            json!({
-                "frame": e.frame,
-                "membrane_force": e.resultants.membrane,
-                "moment": e.resultants.moment,
-                "membrane_stress": e.membrane_stress(),
-                "stress_top": e.surface_stress(true),
-                "stress_bottom": e.surface_stress(false),
-            })
-        })
-        .collect();
-    let reactions: Vec<Value> = r
-        .reactions
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.iter().any(|v| *v != 0.0))
-        .map(|(n, f)| json!({"node": n, "reaction": f}))
-        .collect();
-    let doc = json!({
-        "static": static_summary(&r),
-        "dofs": r.n_free_dofs,
-        "element": model.element.name(),
-        "mesh_quality": quality(&model),
-        "time_s": t0.elapsed().as_secs_f64(),
-        "displacements": r.displacements,
-        "reactions": reactions,
-        "elements": elements,
-        "element_note": "per element, local frame rows [e1, e2, e3]; membrane_force [Nx, Ny, Nxy] N/m (tension +); moment [Mx, My, Mxy] N·m/m at the centroid; stresses Pa, top = +e3 side",
-    });
+    let doc = summary::static_value(&model, &r, t0.elapsed().as_secs_f64());
     emit(args.output.as_deref(), args.force, &doc)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -26,8 +26,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use kappe::calibrate::DesignSource;
-use kappe::design_loop::{OptimizeFile, optimize};
+use kappe::design_loop::{self, OptimizeFile};
 
 use crate::exit::{self, Usage};
 use crate::output::prepare_dir;
@@ -50,30 +49,6 @@ pub struct OptimizeArgs {
     pub quiet: bool,
 }
 
-fn start_design(
-    file: &OptimizeFile,
-    embedded: Option<kappe::Design>,
-    base: &Path,
-) -> Result<kappe::Design> {
-    if let Some(d) = embedded {
-        return Ok(d);
-    }
-    Ok(match &file.design {
-        None => kappe::Design::default(),
-        Some(DesignSource::Inline(d)) => {
-            d.validate().context("invalid inline design")?;
-            (**d).clone()
-        }
-        Some(DesignSource::Path(rel)) => {
-            let path = base.join(rel);
-            let text = std::fs::read_to_string(&path)
-                .with_context(|| format!("cannot read the design file {}", path.display()))?;
-            kappe::Design::from_toml_str(&text)
-                .with_context(|| format!("invalid design file {}", path.display()))?
-        }
-    })
-}
-
 pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     let path = &args.file;
     let text =
@@ -87,97 +62,32 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         file.max_evaluations = n;
     }
     let base = path.parent().unwrap_or(Path::new("."));
-    let start = start_design(&file, embedded, base)?;
+    let start = design_loop::start_design(&file, embedded, base)?;
     // Refusals and unwritable locations fail here, before the loop runs.
     let prepared = prepare_dir(&args.out, args.force, "optimize")?;
     let quiet = args.quiet;
     if !quiet {
-        println!(
-            "{:>5} {:>10} {:>10}  {:<40} failing",
-            "eval", "volume dm³", "violation", "parameters"
-        );
+        println!("{}", design_loop::evaluation_header());
     }
-    let result = optimize(&file, &start, &|e| {
-        if quiet {
-            return;
+    let result = design_loop::optimize(&file, &start, &|e| {
+        if !quiet {
+            println!("{}", e.line());
         }
-        let params: Vec<String> = e
-            .parameters
-            .iter()
-            .map(|(k, v)| format!("{}={v:.4}", k.rsplit('.').next().unwrap_or(k)))
-            .collect();
-        println!(
-            "{:>5} {:>10} {:>10.4}  {:<40} {}",
-            e.evaluation,
-            e.volume_m3
-                .map_or("-".into(), |v| format!("{:.4}", v * 1e3)),
-            e.violation,
-            params.join(" "),
-            e.failing.join(", ")
-        );
     })
     .context("the design loop failed")?;
 
-    let doc = serde_json::json!({
-        "format": "kappe.optimize",
-        "version": 1,
-        "free": file.parameters()?,
-        "result": &result,
-    });
-    let design_toml = result.design.to_toml_string();
+    let doc = design_loop::document(&file, &result)?;
     let dir = prepared.path();
-    std::fs::write(dir.join("design.toml"), &design_toml)?;
+    std::fs::write(dir.join("design.toml"), result.design.to_toml_string())?;
     std::fs::write(dir.join("optimize.json"), serde_json::to_vec_pretty(&doc)?)?;
     if let Some(notice) = prepared.commit()? {
         eprintln!("note: {notice}");
     }
-
-    println!();
-    println!("path taken (accepted moves):");
-    for e in result.evaluations.iter().filter(|e| e.accepted) {
-        let params: Vec<String> = e
-            .parameters
-            .iter()
-            .map(|(k, v)| format!("{k} = {v:.5}"))
-            .collect();
-        println!(
-            "  #{:<4} {}  volume {}",
-            e.evaluation,
-            params.join(", "),
-            e.volume_m3
-                .map_or("-".into(), |v| format!("{:.4} dm³", v * 1e3))
-        );
-    }
-    println!(
-        "{} evaluations; volume {} → {}",
-        result.evaluations.len(),
-        result
-            .start_volume_m3
-            .map_or("-".into(), |v| format!("{:.4} dm³", v * 1e3)),
-        result
-            .volume_m3
-            .map_or("-".into(), |v| format!("{:.4} dm³", v * 1e3)),
-    );
-    if let Some(a) = &result.verification {
-        print!("{}", a.report());
-    }
-    if !result.at_bounds.is_empty() {
-        println!("at bounds: {}", result.at_bounds.join(", "));
-    }
+    print!("{}", result.report());
     if result.feasible {
-        if !result.binding.is_empty() {
-            println!(
-                "binding constraints (within 5 % of their limit): {}",
-                result.binding.join(", ")
-            );
-        }
         println!("wrote {}", args.out.display());
         Ok(ExitCode::SUCCESS)
     } else {
-        println!(
-            "INFEASIBLE within the bounds; binding constraints: {}",
-            result.binding.join(", ")
-        );
         println!("wrote {} (the least-violating design)", args.out.display());
         Ok(exit::fails())
     }

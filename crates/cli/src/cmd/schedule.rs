@@ -40,15 +40,11 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
     };
     let cap = kappe::design_cap(&design, &|_| {})?;
     let plan = kappe::wait_search::least_waits(&cap, &design.analysis, args.wait_max, &|_| {})?;
-    let waits: Vec<f64> = plan.schedule.layers.iter().map(|l| l.wait_s).collect();
-    let doc = serde_json::json!({
-        "format": "kappe.schedule",
-        "version": 1,
-        "time_model": design.time_model()?,
-        "wait_max_s": args.wait_max,
-        "plan": plan,
-    });
-    let json = serde_json::to_string_pretty(&doc)? + "\n";
+    let json = serde_json::to_string_pretty(&kappe::wait_search::document(
+        &design,
+        args.wait_max,
+        &plan,
+    )?)? + "\n";
     if let Some(prepared) = prepared {
         let dir = prepared.path();
         write_file_atomic(&dir.join("schedule.csv"), plan.schedule.to_csv().as_bytes())?;
@@ -60,35 +56,7 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
     if args.json {
         print!("{json}");
     } else {
-        println!(
-            "{} states; print time {:.1} s without waits, {:.1} s with the least waits ({:.1} s of waits)",
-            plan.states.len(),
-            plan.total_without_waits_s,
-            plan.total_s,
-            plan.schedule.total_wait_s()
-        );
-        for b in &plan.binding {
-            println!(
-                "  state {:>4}: wait {:.1} s before its top layer ({} binds)",
-                b.state,
-                b.wait_s,
-                b.check.map_or("-", |m| m.name())
-            );
-        }
-        for c in &plan.infeasible {
-            println!(
-                "  state {:>4}: FAILS even with {:.0} s of wait ({} governs; BLF {:?}, strength {:?}, sliding {:?})",
-                c.state,
-                args.wait_max,
-                c.governing.map_or("-", |m| m.name()),
-                c.blf,
-                c.strength,
-                c.sliding
-            );
-        }
-        let list: Vec<String> = waits.iter().map(|w| format!("{w:.1}")).collect();
-        println!("add to the design to print and check this schedule:");
-        println!("[schedule]\nwaits = [{}]", list.join(", "));
+        print!("{}", kappe::wait_search::text_report(&plan, args.wait_max));
     }
     Ok(if plan.infeasible.is_empty() {
         ExitCode::SUCCESS

@@ -10,11 +10,10 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use kappe::study::{Record, StudyResult, Variation, Verdict};
-use rayon::prelude::*;
+use kappe::study::{Step, StudyResult, Variation};
 
 use crate::exit::Usage;
-use crate::output::prepare_dir;
+use crate::output::{PreparedDir, prepare_dir};
 
 /// `kappe study`: run a study file, or merge shards.
 #[derive(Args)]
@@ -87,89 +86,20 @@ pub fn run(cmd: StudyCommand) -> Result<ExitCode> {
     }
 }
 
-/// The shard of this task of a Slurm job array (`--shard` without a value).
-fn slurm_shard() -> Result<(usize, usize)> {
-    let var = |k: &str| -> Result<Option<usize>> {
-        match std::env::var(k) {
-            Err(_) => Ok(None),
-            Ok(v) => v.trim().parse().map(Some).map_err(|_| {
-                crate::exit::Usage(format!("--shard: {k}={v:?} is not a whole number")).into()
-            }),
-        }
+/// Writes `designs/<name>/`: `design.toml` before the run, `summary.json` and `report.html`
+/// after it.
+fn store(prepared: &PreparedDir, v: &Variation, step: Step<'_>) -> Result<(), String> {
+    let files = match step {
+        Step::Start => Ok(v.files_before()),
+        Step::Done(run) => run.files(v),
     };
-    let (Some(id), Some(count)) = (var("SLURM_ARRAY_TASK_ID")?, var("SLURM_ARRAY_TASK_COUNT")?)
-    else {
-        return Err(crate::exit::Usage(
-            "--shard without i/n needs SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT (a Slurm job \
-             array); give --shard i/n otherwise"
-                .into(),
-        )
-        .into());
-    };
-    let min = var("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
-    let spec = format!("{}/{count}", id.saturating_sub(min));
-    Ok(kappe::study::parse_shard(&spec)?)
-}
-
-/// Writes `study.json`, `study.csv` and `study.html` into `dir`.
-fn write_study_files(dir: &Path, result: &StudyResult) -> Result<()> {
-    let html = result.html().context("cannot render study.html")?;
-    std::fs::write(dir.join("study.json"), result.to_json())?;
-    std::fs::write(dir.join("study.csv"), result.csv())?;
-    std::fs::write(dir.join("study.html"), html)?;
-    Ok(())
-}
-
-/// Runs one design and writes `designs/<name>/` under `root`. Any failure becomes an error row.
-fn run_one(v: &Variation, parameter_paths: &[String], no_robot: bool, root: &Path) -> Record {
-    let parameters = kappe::study::parameter_values(v, parameter_paths);
-    let dir = root.join("designs").join(&v.name);
-    if let Err(e) = std::fs::create_dir_all(&dir)
-        .and_then(|()| std::fs::write(dir.join("design.toml"), v.design_toml().as_bytes()))
-    {
-        return kappe::study::error_record(
-            v,
-            parameters,
-            format!("cannot write {}: {e}", dir.display()),
-        );
-    }
-    let run = kappe::study::run_one(v, parameters.clone(), no_robot);
-    let write = || -> std::io::Result<()> {
-        if let Some(summary) = &run.summary {
-            std::fs::write(
-                dir.join("summary.json"),
-                serde_json::to_vec_pretty(summary)?,
-            )?;
-        }
-        if let Some(html) = &run.report_html {
-            std::fs::write(dir.join("report.html"), html)?;
-        }
-        Ok(())
-    };
-    match write() {
-        Ok(()) => run.record,
-        Err(e) => kappe::study::error_record(v, parameters, e.to_string()),
-    }
+    files
+        .and_then(|f| prepared.write(&f))
+        .map_err(|e| e.to_string())
 }
 
 fn print_summary(result: &StudyResult, out: &Path) {
-    let count = |o: Verdict| result.rows.iter().filter(|r| r.outcome == o).count();
-    println!(
-        "study \"{}\": {} of {} designs{}: {} pass, {} fail, {} could not be run",
-        result.title,
-        result.rows.len(),
-        result.designs.len(),
-        result
-            .shard
-            .map(|[i, n]| format!(" (shard {i}/{n})"))
-            .unwrap_or_default(),
-        count(Verdict::Pass),
-        count(Verdict::Fail),
-        count(Verdict::Error),
-    );
-    for r in result.rows.iter().filter(|r| r.outcome == Verdict::Error) {
-        println!("  {}: {}", r.name, r.error.as_deref().unwrap_or(""));
-    }
+    print!("{}", result.overview());
     println!(
         "  wrote {}/{{study.csv, study.html, study.json, designs/}}",
         out.display()
@@ -181,7 +111,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         return Err(Usage("give a STUDY.toml and --out DIR".into()).into());
     };
     let shard = match args.shard.as_deref() {
-        Some("slurm") => Some(slurm_shard()?),
+        Some("slurm") => Some(kappe::study::slurm_shard(|k| std::env::var(k).ok())?),
         other => other.map(kappe::study::parse_shard).transpose()?,
     };
     let text = std::fs::read_to_string(&path)
@@ -207,32 +137,29 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         b.set_message("study");
         b
     };
-    let pool = {
-        let mut builder = rayon::ThreadPoolBuilder::new();
-        if let Some(j) = args.jobs {
-            if j == 0 {
-                return Err(Usage("--jobs 0: give at least 1".into()).into());
-            }
-            builder = builder.num_threads(j);
-        }
-        builder.build().context("cannot start the worker threads")?
-    };
+    if args.jobs == Some(0) {
+        return Err(Usage("--jobs 0: give at least 1".into()).into());
+    }
     // Refusals and unwritable locations fail here, before any design runs.
     let prepared = prepare_dir(&out, args.force, "study")?;
-    let dir = prepared.path();
-    std::fs::create_dir_all(dir.join("designs"))?;
-    let rows: Vec<Record> = pool.install(|| {
-        selected
-            .par_iter()
-            .map(|v| {
-                let r = run_one(v, &study.parameters, args.no_robot, dir);
+    std::fs::create_dir_all(prepared.path().join("designs"))?;
+    let rows = kappe::study::run_designs(
+        &selected,
+        &study.parameters,
+        args.no_robot,
+        args.jobs,
+        &|v, step| {
+            let done = matches!(step, Step::Done(_));
+            let r = store(&prepared, v, step);
+            if done {
                 bar.inc(1);
-                r
-            })
-            .collect()
-    });
+            }
+            r
+        },
+    )
+    .context("cannot start the worker threads")?;
     let result = kappe::study::collect(&study, shard, args.no_robot, rows)?;
-    write_study_files(dir, &result)?;
+    prepared.write(&result.files()?)?;
     if let Some(notice) = prepared.commit()? {
         eprintln!("note: {notice}");
     }
@@ -241,7 +168,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         print_summary(&result, &out);
     }
     // Status 1 when any design fails or could not run (the scheme of `kappe --help`).
-    if result.rows.iter().any(|row| row.outcome != Verdict::Pass) {
+    if !result.all_pass() {
         return Ok(crate::exit::fails());
     }
     Ok(ExitCode::SUCCESS)
@@ -308,7 +235,7 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
             }
         }
         std::fs::create_dir_all(dir.join("designs"))?;
-        write_study_files(dir, &merged.result)?;
+        prepared.write(&merged.result.files()?)?;
     }
     if let Some(notice) = prepared.commit()? {
         eprintln!("note: {notice}");
@@ -316,12 +243,7 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
     if !args.quiet {
         print_summary(&merged.result, &args.out);
     }
-    if merged
-        .result
-        .rows
-        .iter()
-        .any(|row| row.outcome != Verdict::Pass)
-    {
+    if !merged.result.all_pass() {
         return Ok(crate::exit::fails());
     }
     Ok(ExitCode::SUCCESS)

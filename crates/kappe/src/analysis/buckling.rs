@@ -32,13 +32,27 @@ pub enum BucklingStatus {
 /// The shell material of the state with top print index `top`: the design's material, with
 /// every layer's modulus from its age when `options.ageing` is set.
 pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> ShellMaterial {
+    state_material_with(
+        cap,
+        options,
+        top,
+        crate::green::CapGreen::new(cap).ok().as_ref(),
+    )
+}
+
+/// [`state_material`] with the layers' ages from `green`'s schedule (e.g. the robot plan's
+/// clock); `None`: the material without a time model.
+pub fn state_material_with(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    top: usize,
+    green: Option<&crate::green::CapGreen>,
+) -> ShellMaterial {
     let d = &cap.design;
     let layer_modulus = match &options.ageing {
         // `[material.time]` (issue 11): E per layer from its age on the cap's schedule; empty
         // for the constant model, so the shell is exactly the one without a time model.
-        None => crate::green::CapGreen::new(cap)
-            .map(|g| g.layer_moduli(cap, top))
-            .unwrap_or_else(|_| HashMap::new()),
+        None => green.map_or_else(HashMap::new, |g| g.layer_moduli(cap, top)),
         Some(a) => layer_ages(&cap.sections, d.print.print_speed, top)
             .into_iter()
             .map(|(id, t)| (id, a.modulus(t)))
@@ -89,17 +103,38 @@ pub fn state_buckling_mode(
     material: &ShellMaterial,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode), DesignError> {
+    state_buckling_warm(state, material, options, None).map(|(b, m, _)| (b, m))
+}
+
+/// Mode 1 of a state per shell node, keyed by (layer id, index of the node in its layer): keys
+/// that mean the same material point in every state, so one state's mode can start the
+/// eigensolver of the next ([`state_buckling_warm`]).
+pub type ModeGuess = HashMap<(i32, usize), [f64; 6]>;
+
+/// How far below a layer missing from a [`ModeGuess`] (a new top layer, or a row the previous
+/// mesh did not keep) its guess is looked up: the largest stride of a graded mesh is far less.
+const GUESS_REACH: i32 = 256;
+
+/// [`state_buckling_mode`] started from `guess` (the mode of a nearby state; `None`: a random
+/// start), also returning this state's mode as a [`ModeGuess`] for the next state. The guess
+/// only saves Lanczos steps: the result meets the same residual bound either way.
+pub fn state_buckling_warm(
+    state: &State,
+    material: &ShellMaterial,
+    options: &AnalysisOptions,
+    guess: Option<&ModeGuess>,
+) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
     // A graded mesh (issue 15, `crate::window`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
     let graded;
-    let (state, node_map) = match &options.grading {
+    let (reduced, node_map) = match &options.grading {
         Some(g) => {
             graded = crate::window::graded_state_map(state, g);
             (&graded.0, Some(&graded.1))
         }
         None => (state, None),
     };
-    let shell = match state_shell(state, material, options.row_stride) {
+    let shell = match state_shell(reduced, material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
             return Ok((
@@ -111,16 +146,51 @@ pub fn state_buckling_mode(
                     shell_nodes: 0,
                 },
                 Vec::new(),
+                ModeGuess::new(),
             ));
         }
     };
-    let (b, mut mode) = shell_buckling_mode(&shell, state.index, options)?;
-    if let Some(map) = node_map {
-        for (k, _) in &mut mode {
-            *k = map.get(*k).copied().unwrap_or(*k);
+    let full_index = |k: usize| node_map.map_or(Some(k), |m| m.get(k).copied());
+    // First network index of every layer: the network stores each layer contiguously.
+    let mut first: HashMap<i32, usize> = HashMap::new();
+    for (i, n) in state.network.nodes.iter().enumerate() {
+        if n.role != crate::states::Role::ColumnEnd {
+            first.entry(n.layer).or_insert(i);
         }
     }
-    Ok((b, mode))
+    let keys: Vec<Option<(i32, usize)>> = shell
+        .network_node
+        .iter()
+        .map(|&k| {
+            let i = full_index(k)?;
+            let layer = state.network.nodes.get(i)?.layer;
+            Some((layer, i.checked_sub(*first.get(&layer)?)?))
+        })
+        .collect();
+    let start = guess.filter(|g| !g.is_empty()).map(|g| {
+        keys.iter()
+            .map(|key| {
+                key.and_then(|(layer, k)| {
+                    (0..GUESS_REACH).find_map(|down| g.get(&(layer - down, k)).copied())
+                })
+                .unwrap_or([0.0; 6])
+            })
+            .collect()
+    });
+    let (b, mode, full, _) = shell_buckling_run(&shell, state.index, options, start)?;
+    let mode = mode
+        .into_iter()
+        .map(|(k, d)| (full_index(k).unwrap_or(k), d))
+        .collect();
+    let next = full
+        .map(|m| {
+            keys.iter()
+                .zip(m)
+                .filter_map(|(key, d)| key.map(|key| (key, d)))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok((b, mode, next))
 }
 
 /// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
@@ -151,12 +221,40 @@ pub fn shell_buckling_full(
     state: usize,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode, Option<kappe_fe::StaticResult>), DesignError> {
+    shell_buckling_run(shell, state, options, None).map(|(b, m, _, s)| (b, m, s))
+}
+
+/// One buckling solve of a shell model, started from `start` (per shell node) if given; also
+/// returns mode 1 with all six freedoms per shell node.
+#[allow(clippy::type_complexity)]
+fn shell_buckling_run(
+    shell: &StateShell,
+    state: usize,
+    options: &AnalysisOptions,
+    start: Option<Vec<[f64; 6]>>,
+) -> Result<
+    (
+        StateBuckling,
+        NetworkMode,
+        Option<Vec<[f64; 6]>>,
+        Option<kappe_fe::StaticResult>,
+    ),
+    DesignError,
+> {
     let fe_opts = kappe_fe::BucklingOptions {
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
-        // modelling error and saves Lanczos steps over the default 1e-10.
-        tolerance: 1e-8,
+        // modelling error and saves Lanczos steps over the default 1e-10. A graded mesh is
+        // itself an approximation (≤ 1 %, `crate::window`): there 1e-6 suffices, since a Ritz
+        // value with relative residual r lies within r (and, given the gap to the next mode,
+        // within ~r²) of an eigenvalue of the symmetric operator.
+        tolerance: if options.grading.is_some() {
+            1e-6
+        } else {
+            1e-8
+        },
         sturm_check: options.sturm_check,
+        start,
         ..Default::default()
     };
     let n = shell.model.nodes.len();
@@ -181,6 +279,7 @@ pub fn shell_buckling_full(
                         .collect()
                 })
                 .unwrap_or_default();
+            let full = r.modes.into_iter().next();
             Ok((
                 StateBuckling {
                     status: if r.factors.is_empty() {
@@ -194,6 +293,7 @@ pub fn shell_buckling_full(
                     shell_nodes: n,
                 },
                 mode,
+                full,
                 static_result,
             ))
         }
@@ -223,6 +323,7 @@ pub fn shell_buckling_full(
                     shell_nodes: n,
                 },
                 Vec::new(),
+                None,
                 None,
             ))
         }

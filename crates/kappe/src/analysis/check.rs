@@ -8,14 +8,18 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, NetworkMode, StateBuckling, shell_buckling_full, state_buckling_mode,
-    state_material,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_mode,
+    state_buckling_warm, state_material_with,
 };
 use super::options::AnalysisOptions;
-use super::stress::{ElementStress, STRESS_REL_TOL, element_stresses};
+use super::stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 use crate::error::DesignError;
 use crate::pipeline::Cap;
 use crate::states::build_state;
+
+/// Consecutive states per warm-started run of the graded analysis: each run's first state
+/// starts cold, so longer runs save more Lanczos steps; shorter ones balance the cores better.
+const WARM_RUN: usize = 32;
 
 /// The analysis of one print state.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -145,6 +149,31 @@ impl Analysis {
     }
 }
 
+/// The extremes of one state's element stresses: the first element with the lowest and with the
+/// highest stress (the order `element_stresses` gives), and the largest |σ|.
+#[derive(Debug, Clone, Copy, Default)]
+struct StressExtremes {
+    min: Option<(f64, ElementKind)>,
+    max: Option<(f64, ElementKind)>,
+    abs_max: f64,
+}
+
+impl StressExtremes {
+    fn of(stresses: &[ElementStress]) -> Self {
+        let mut e = StressExtremes::default();
+        for s in stresses {
+            if e.min.is_none_or(|m| s.stress < m.0) {
+                e.min = Some((s.stress, s.kind));
+            }
+            if e.max.is_none_or(|m| s.stress > m.0) {
+                e.max = Some((s.stress, s.kind));
+            }
+            e.abs_max = e.abs_max.max(s.stress.abs());
+        }
+        e
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Worst {
     value: f64,
@@ -190,6 +219,18 @@ pub(crate) fn analyze_until(
     on_state: &(dyn Fn(usize) + Sync),
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
+    analyze_scheduled(cap, options, None, on_state, stop)
+}
+
+/// [`analyze_until`] with the layers' ages from `schedule` (the timed robot plan's, issue 11;
+/// `None`: path length / print speed and the `[schedule]` waits).
+pub(crate) fn analyze_scheduled(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    schedule: Option<&crate::schedule::Schedule>,
+    on_state: &(dyn Fn(usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Analysis, DesignError> {
     options.validate()?;
     let cancelled = || {
         if stop.load(Ordering::Relaxed) {
@@ -216,7 +257,7 @@ pub(crate) fn analyze_until(
     };
 
     struct PerState {
-        stresses: Vec<ElementStress>,
+        stresses: StressExtremes,
         stress_seconds: f64,
         buckling: Option<StateBuckling>,
         mode: NetworkMode,
@@ -230,7 +271,7 @@ pub(crate) fn analyze_until(
     );
     // Green state (issue 11): strength and bed-joint sliding with the layers' ages, only when
     // `[material.time]` gives a strength model (otherwise nothing changes).
-    let green = crate::green::CapGreen::new(cap)?;
+    let green = crate::green::CapGreen::with_schedule(cap, schedule)?;
     let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
     // Phase 1: every state's force pass and element stresses (cheap).
     let t_phase = Instant::now();
@@ -240,7 +281,9 @@ pub(crate) fn analyze_until(
             cancelled()?;
             let t0 = Instant::now();
             let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-            let stresses = element_stresses(&state, areas)?;
+            // Only the extremes are kept: all element stresses of every state would take memory
+            // quadratic in the bay length (0.7 GB for a 4 m bay).
+            let stresses = StressExtremes::of(&element_stresses(&state, areas)?);
             Ok(PerState {
                 stresses,
                 stress_seconds: t0.elapsed().as_secs_f64(),
@@ -256,40 +299,62 @@ pub(crate) fn analyze_until(
     // Phase 2: the buckling analysis of the selected states, largest first so the two cores
     // finish together.
     let t_phase = Instant::now();
-    let mut order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
-    order.reverse();
+    let order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
     let n_fe = order.len();
+    // With a graded mesh (issue 15) consecutive states share most of their mesh, so each state's
+    // eigensolve starts from the previous state's mode: the selected states run in contiguous
+    // runs, one after another within a run, the runs in parallel (largest first). The start
+    // changes the Lanczos steps, not the converged result (`state_buckling_warm`). The
+    // green-state strength path (`CapGreen::state_checks`) starts cold.
+    let warm = options.grading.is_some();
+    let runs: Vec<Vec<usize>> = if warm {
+        order
+            .chunks(WARM_RUN)
+            .rev()
+            .map(<[usize]>::to_vec)
+            .collect()
+    } else {
+        order.iter().rev().map(|&i| vec![i]).collect()
+    };
     #[allow(clippy::type_complexity)]
-    let fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> = order
+    let fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> = runs
         .into_par_iter()
-        .map(|top| {
-            cancelled()?;
-            let t0 = Instant::now();
-            let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-            let mat = state_material(cap, options, top);
-            // With a strength model the buckling solve's own static solution gives the
-            // membrane stresses (one factorization per state, not two).
-            let shell = match &green {
-                Some(g) if g.time.strength.is_some() => {
-                    crate::shell::state_shell(&state, &mat, options.row_stride).ok()
-                }
-                _ => None,
-            };
-            let (b, mode, g) = match (&green, shell) {
-                (Some(gr), Some(shell)) => {
-                    let (b, mode, st) = shell_buckling_full(&shell, state.index, options)?;
-                    let g = st.map(|st| gr.stress_checks_on(&shell, &st, top));
-                    (b, mode, g)
-                }
-                _ => {
-                    let (b, mode) = state_buckling_mode(&state, &mat, options)?;
-                    (b, mode, None)
-                }
-            };
-            on_state(n_fe);
-            Ok((top, b, mode, g, t0.elapsed().as_secs_f64()))
+        .map(|run| {
+            let mut guess: Option<ModeGuess> = None;
+            let mut out = Vec::with_capacity(run.len());
+            for top in run {
+                cancelled()?;
+                let t0 = Instant::now();
+                let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+                let mat = state_material_with(cap, options, top, green.as_ref());
+                // With a strength model the buckling solve's own static solution gives the
+                // membrane stresses (one factorization per state, not two).
+                let checked = match &green {
+                    Some(g) => g.state_checks(&state, &mat, options, top)?,
+                    None => None,
+                };
+                let (b, mode, g) = match checked {
+                    Some(c) => c,
+                    _ if warm => {
+                        let (b, mode, next) =
+                            state_buckling_warm(&state, &mat, options, guess.as_ref())?;
+                        guess = Some(next);
+                        (b, mode, None)
+                    }
+                    _ => {
+                        let (b, mode) = state_buckling_mode(&state, &mat, options)?;
+                        (b, mode, None)
+                    }
+                };
+                on_state(n_fe);
+                out.push((top, b, mode, g, t0.elapsed().as_secs_f64()));
+            }
+            Ok(out)
         })
-        .collect::<Result<_, DesignError>>()?;
+        .collect::<Result<Vec<_>, DesignError>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let wall_fe = t_phase.elapsed().as_secs_f64();
     for (top, b, mode, g, secs) in fe {
         if let Some(p) = per.get_mut(top) {
@@ -308,10 +373,7 @@ pub(crate) fn analyze_until(
         design.constraints.sigma_max,
         design.constraints.blf_min,
     );
-    let stress_scale = per
-        .iter()
-        .flat_map(|p| p.stresses.iter())
-        .fold(0.0_f64, |m, s| m.max(s.stress.abs()));
+    let stress_scale = per.iter().fold(0.0_f64, |m, p| m.max(p.stresses.abs_max));
     let stol = STRESS_REL_TOL * stress_scale;
 
     let mut w_comp: Option<Worst> = None;
@@ -329,13 +391,15 @@ pub(crate) fn analyze_until(
     for (q, p) in per.iter().enumerate() {
         t_stress += p.stress_seconds;
         t_fe += p.fe_seconds;
-        let mut smin: f64 = 0.0;
-        let mut smax: f64 = 0.0;
-        for s in &p.stresses {
-            smin = smin.min(s.stress);
-            smax = smax.max(s.stress);
-            keep_min(&mut w_comp, s.stress, q, || s.kind.to_string());
-            keep_max(&mut w_tens, s.stress, q, || s.kind.to_string());
+        let (smin, smax) = (
+            p.stresses.min.map_or(0.0, |m| m.0.min(0.0)),
+            p.stresses.max.map_or(0.0, |m| m.0.max(0.0)),
+        );
+        if let Some((v, kind)) = p.stresses.min {
+            keep_min(&mut w_comp, v, q, || kind.to_string());
+        }
+        if let Some((v, kind)) = p.stresses.max {
+            keep_max(&mut w_tens, v, q, || kind.to_string());
         }
         let lo = overhang_of(q);
         let layer_id = cap.sections.layers.get(q).map_or(0, |l| l.id);

@@ -413,3 +413,100 @@ pub fn parse_shard(spec: &str) -> Result<(usize, usize)> {
     }
     Ok((i, n))
 }
+
+/// The shard of this task of a Slurm job array (`kappe study --shard` without `i/n`):
+/// i = `SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN` (0 when unset), n =
+/// `SLURM_ARRAY_TASK_COUNT`. `var` reads a variable (`std::env::var(..).ok()` in the
+/// command; a map in tests).
+pub fn slurm_shard(var: impl Fn(&str) -> Option<String>) -> Result<(usize, usize)> {
+    let number = |k: &str| -> Result<Option<usize>> {
+        match var(k) {
+            None => Ok(None),
+            Some(v) => v.trim().parse().map(Some).map_err(|_| {
+                StudyError::Shard(format!("--shard: {k}={v:?} is not a whole number"))
+            }),
+        }
+    };
+    let (Some(id), Some(count)) = (
+        number("SLURM_ARRAY_TASK_ID")?,
+        number("SLURM_ARRAY_TASK_COUNT")?,
+    ) else {
+        return Err(StudyError::Shard(
+            "--shard without i/n needs SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT (a Slurm job \
+             array); give --shard i/n otherwise"
+                .into(),
+        ));
+    };
+    let min = number("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+    let Some(i) = id.checked_sub(min) else {
+        return Err(StudyError::Shard(format!(
+            "--shard: SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"
+        )));
+    };
+    if count > 0 && i >= count {
+        return Err(StudyError::Shard(format!(
+            "--shard: SLURM_ARRAY_TASK_ID={id} − SLURM_ARRAY_TASK_MIN={min} = {i} is not below \
+             SLURM_ARRAY_TASK_COUNT={count} (an array of {count} tasks has the shards 0..={})",
+            count - 1
+        )));
+    }
+    parse_shard(&format!("{i}/{count}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env<'a>(vars: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
+        move |k| {
+            vars.iter()
+                .find(|(name, _)| *name == k)
+                .map(|(_, v)| (*v).to_string())
+        }
+    }
+
+    #[test]
+    fn slurm_shard_is_id_minus_min_of_count() {
+        let id_min_count = [
+            ("SLURM_ARRAY_TASK_ID", "7"),
+            ("SLURM_ARRAY_TASK_MIN", "5"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
+        assert_eq!(slurm_shard(env(&id_min_count)).ok(), Some((2, 4)));
+        let no_min = [
+            ("SLURM_ARRAY_TASK_ID", "3"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
+        assert_eq!(slurm_shard(env(&no_min)).ok(), Some((3, 4)));
+        // The last task of `--array=5-8` is shard 3 of 4; one more is outside the array.
+        let last = [
+            ("SLURM_ARRAY_TASK_ID", "8"),
+            ("SLURM_ARRAY_TASK_MIN", "5"),
+            ("SLURM_ARRAY_TASK_COUNT", "4"),
+        ];
+        assert_eq!(slurm_shard(env(&last)).ok(), Some((3, 4)));
+        for bad in [
+            &[
+                ("SLURM_ARRAY_TASK_ID", "9"),
+                ("SLURM_ARRAY_TASK_MIN", "5"),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+            ][..],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "4"),
+                ("SLURM_ARRAY_TASK_MIN", "5"),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+            ][..],
+            &[
+                ("SLURM_ARRAY_TASK_ID", "-1"),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+            ][..],
+            &[("SLURM_ARRAY_TASK_COUNT", "4")][..],
+            &[][..],
+        ] {
+            assert!(
+                matches!(slurm_shard(env(bad)), Err(StudyError::Shard(_))),
+                "{bad:?}"
+            );
+        }
+    }
+}

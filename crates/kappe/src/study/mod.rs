@@ -57,9 +57,9 @@ mod merge;
 mod run;
 mod table;
 
-pub use file::{get_path, parse, parse_shard, show};
+pub use file::{get_path, parse, parse_shard, show, slurm_shard};
 pub use merge::{Merged, merge};
-pub use run::{DesignRun, collect, error_record, parameter_values, run_one};
+pub use run::{DesignRun, Step, collect, error_record, parameter_values, run_designs, run_one};
 
 use kappe_report::ConstraintRow;
 use serde::{Deserialize, Serialize};
@@ -211,5 +211,33 @@ impl StudyResult {
     /// `study.json`, pretty-printed.
     pub fn to_json(&self) -> Vec<u8> {
         serde_json::to_vec_pretty(self).unwrap_or_default()
+    }
+
+    /// Whether every design of the rows ran and passes (`kappe study` exits 0, else 1).
+    pub fn all_pass(&self) -> bool {
+        self.rows.iter().all(|r| r.outcome == Verdict::Pass)
+    }
+
+    /// The study in a few lines: how many designs pass, fail or could not run, and why each
+    /// of the last could not.
+    pub fn overview(&self) -> String {
+        use std::fmt::Write;
+        let count = |o: Verdict| self.rows.iter().filter(|r| r.outcome == o).count();
+        let mut s = format!(
+            "study \"{}\": {} of {} designs{}: {} pass, {} fail, {} could not be run\n",
+            self.title,
+            self.rows.len(),
+            self.designs.len(),
+            self.shard
+                .map(|[i, n]| format!(" (shard {i}/{n})"))
+                .unwrap_or_default(),
+            count(Verdict::Pass),
+            count(Verdict::Fail),
+            count(Verdict::Error),
+        );
+        for r in self.rows.iter().filter(|r| r.outcome == Verdict::Error) {
+            let _ = writeln!(s, "  {}: {}", r.name, r.error.as_deref().unwrap_or(""));
+        }
+        s
     }
 }

@@ -165,3 +165,107 @@ pub fn collect(
     let bytes = serde_json::to_vec(&r).map_err(|e| StudyError::Merge(e.to_string()))?;
     serde_json::from_slice(&bytes).map_err(|e| StudyError::Merge(e.to_string()))
 }
+
+/// Where [`run_designs`] is with a design: about to run it, or done with it.
+pub enum Step<'a> {
+    /// Before the run (the command writes `designs/<name>/design.toml` here).
+    Start,
+    /// After the run (the command writes `summary.json` and `report.html` here).
+    Done(&'a DesignRun),
+}
+
+/// Runs `designs` in parallel on `jobs` threads (default: one per core) with [`run_one`],
+/// calling `store(v, step)` on the worker thread before and after each design; an `Err` from
+/// `store` (say, a file that cannot be written) makes the design an error row with that
+/// reason. Returns the rows in the order of `designs`.
+///
+/// # Errors
+/// The worker threads cannot be started.
+pub fn run_designs(
+    designs: &[&Variation],
+    parameter_paths: &[String],
+    no_robot: bool,
+    jobs: Option<usize>,
+    store: &(dyn Fn(&Variation, Step<'_>) -> Result<(), String> + Sync),
+) -> Result<Vec<Record>, rayon::ThreadPoolBuildError> {
+    use rayon::prelude::*;
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(j) = jobs {
+        builder = builder.num_threads(j);
+    }
+    let pool = builder.build()?;
+    Ok(pool.install(|| {
+        designs
+            .par_iter()
+            .map(|v| {
+                let parameters = parameter_values(v, parameter_paths);
+                if let Err(reason) = store(v, Step::Start) {
+                    return error_record(v, parameters, reason);
+                }
+                let run = run_one(v, parameters.clone(), no_robot);
+                match store(v, Step::Done(&run)) {
+                    Ok(()) => run.record,
+                    Err(reason) => error_record(v, parameters, reason),
+                }
+            })
+            .collect()
+    }))
+}
+
+impl Variation {
+    /// `designs/<name>/design.toml`: what a design directory holds before the design runs.
+    pub fn files_before(&self) -> Vec<crate::output::OutputFile> {
+        vec![crate::output::OutputFile::new(
+            format!("designs/{}/design.toml", self.name),
+            self.design_toml(),
+        )]
+    }
+}
+
+impl DesignRun {
+    /// `designs/<name>/summary.json` and `report.html` of `v` after its run (none for a design
+    /// that could not run).
+    ///
+    /// # Errors
+    /// [`crate::output::OutputError::Produce`] when the summary cannot be serialized.
+    pub fn files(
+        &self,
+        v: &Variation,
+    ) -> Result<Vec<crate::output::OutputFile>, crate::output::OutputError> {
+        use crate::output::{OutputError, OutputFile};
+        let mut out = Vec::new();
+        if let Some(summary) = &self.summary {
+            let bytes = serde_json::to_vec_pretty(summary)
+                .map_err(|e| OutputError::Produce(format!("cannot write summary.json: {e}")))?;
+            out.push(OutputFile::new(
+                format!("designs/{}/summary.json", v.name),
+                bytes,
+            ));
+        }
+        if let Some(html) = &self.report_html {
+            out.push(OutputFile::new(
+                format!("designs/{}/report.html", v.name),
+                html.as_bytes(),
+            ));
+        }
+        Ok(out)
+    }
+}
+
+impl StudyResult {
+    /// `study.json`, `study.csv` and `study.html`.
+    ///
+    /// # Errors
+    /// [`crate::output::OutputError::Produce`] when the table page cannot be rendered.
+    pub fn files(&self) -> Result<Vec<crate::output::OutputFile>, crate::output::OutputError> {
+        use crate::output::{OutputError, OutputFile};
+        let html = self
+            .html()
+            .map_err(|e| OutputError::Produce(format!("cannot render study.html: {e}")))?;
+        Ok(vec![
+            OutputFile::new("study.json", self.to_json()),
+            OutputFile::new("study.csv", self.csv()),
+            OutputFile::new("study.html", html),
+        ])
+    }
+}

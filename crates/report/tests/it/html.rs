@@ -269,3 +269,34 @@ fn island_reads_back_into_a_valid_input() {
         }
     }
 }
+
+#[test]
+fn robot_section_shows_slowdowns_and_both_models_clearances() {
+    let mut input = demo_input();
+    let html = render_html(&input).unwrap();
+    let section = &html[html.find("id=\"robot-check\"").unwrap()..];
+    let section = &section[..section.find("</section>").unwrap()];
+    // The demo's slowdown: where (station, layers/points), by how much (ratio and speed), why.
+    assert!(section.contains("id=\"slowdown-table\""), "{section}");
+    assert!(section.contains("<td class=\"num\">3 / 10</td><td class=\"num\">3 / 14</td>"));
+    assert!(section.contains("86.0 % (43.0 mm/s)"), "{section}");
+    assert!(section.contains("joint acceleration"));
+    // The clearance at the waypoints next to the certified bound along the motion.
+    assert!(section.contains("55.5 mm"), "{section}");
+    assert!(section.contains("31.0 mm"), "{section}");
+    // No slowdown: one sentence with the design speed and the largest joint ratios.
+    input.robot_summary.as_mut().unwrap().slowdowns.clear();
+    let html = render_html(&input).unwrap();
+    assert!(html.contains("keeps the design speed of 50 mm/s"));
+    assert!(!html.contains("slowdown-table"));
+    // A non-finite clearance is refused, naming the field.
+    input.robot_summary.as_mut().unwrap().clearances[0].along_motion = Some(f64::NAN);
+    let e = render_html(&input).unwrap_err().to_string();
+    assert!(
+        e.contains("robot_summary.clearances[0].along_motion"),
+        "{e}"
+    );
+    // No robot summary: no section.
+    input.robot_summary = None;
+    assert!(!render_html(&input).unwrap().contains("robot-check"));
+}

@@ -7,3 +7,4 @@ mod kinematics;
 mod ladder;
 mod plan;
 mod program;
+mod sweep;

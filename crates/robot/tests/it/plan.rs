@@ -179,3 +179,73 @@ fn exports_round_trip() {
     let back: Plan = serde_json::from_slice(&json).unwrap();
     assert!(check_plan(&back).problems.is_empty());
 }
+
+#[test]
+fn joint_position_limits_are_validated_and_used_by_planner_check_and_lint() {
+    let (layers, setup, opts) = small();
+    let layers = &layers[..3];
+    let with = |j: usize, r: [f64; 2]| {
+        let mut o = opts.clone();
+        o.limits.position_deg[j] = r;
+        o
+    };
+    // Bad values: each is the named error, with the joint (1-based) and the range.
+    for (j, r) in [
+        (0, [10.0, 10.0]),
+        (1, [f64::NAN, 90.0]),
+        (2, [-190.0, 361.0]),
+        (5, [-400.0, 0.0]),
+    ] {
+        let e = plan_print(layers, &setup, &with(j, r)).unwrap_err();
+        assert!(
+            matches!(e, RobotError::JointPositionLimit { joint, .. } if joint == j + 1),
+            "{e}"
+        );
+        assert!(e.to_string().contains("±360°"), "{e}");
+    }
+    // The default plan, and the range its base joint actually uses.
+    let plan = plan_print(layers, &setup, &opts).unwrap();
+    let q1: Vec<f64> = plan.stations[0]
+        .layers
+        .iter()
+        .flat_map(|l| &l.waypoints)
+        .map(|w| w.q[0].to_degrees())
+        .collect();
+    let (lo, hi) = q1
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    // Limits that leave the base joint 1° short of its range: no plan (whole turns do not help
+    // a range narrower than a turn).
+    let e = plan_print(layers, &setup, &with(0, [lo + 1.0, hi + 1.0]));
+    assert!(e.is_err(), "planned inside too narrow limits");
+    // Limits that hold the used range (and the approach and retract, 10° more) plan the same
+    // print, and the check holds them.
+    let ok = plan_print(layers, &setup, &with(0, [lo - 10.0, hi + 10.0])).unwrap();
+    assert_eq!(ok.waypoint_count(), plan.waypoint_count());
+    // Narrowing the limits after planning makes the check fail on the same plan.
+    let mut narrowed = ok.clone();
+    narrowed.options.limits.position_deg[0] = [lo + 1.0, hi + 1.0];
+    let rep = check_plan(&narrowed);
+    assert!(
+        rep.problems
+            .iter()
+            .any(|p| p.contains("outside the limits")),
+        "{:?}",
+        rep.problems
+    );
+    // Lint: the same movej is fine with the UR10e limits and rejected beyond narrowed ones.
+    let prog = "def p():\n  movej([0.5, -1.0, 1.0, -1.5, -1.57, 0.0], a=1.0, v=0.5)\nend\np()\n";
+    assert!(lint(prog, 10).ok());
+    let mut lim = kappe_robot::setup::JointLimitOptions::default().position();
+    lim[0] = [-0.2, 0.2];
+    let rep = lint_with_limits(prog, 10, &lim);
+    assert!(
+        rep.problems
+            .iter()
+            .any(|p| p.contains("joint 1") && p.contains("beyond its limits")),
+        "{:?}",
+        rep.problems
+    );
+}

@@ -292,6 +292,90 @@ fn programs_lint_fit_and_switch_the_pump_once_per_station() {
 }
 
 #[test]
+fn program_files_are_balanced() {
+    let (layers, setup, mut opts) = small();
+    // 40 targets: 3 layers of 12 points per file, so a greedy cut of the 16 layers would end
+    // with a file of one layer (3,3,3,3,3,1); a balanced one is 3,3,3,3,2,2.
+    opts.program.max_moves_per_program = 40;
+    let plan = plan_print(&layers, &setup, &opts).unwrap();
+    // Per station the fewest files; the largest as small as any cut into that many files can
+    // make it; then the smallest as large as possible (an exhaustive search over the cuts, with
+    // a file's target count restated here: approach movej + movel + the other points for a
+    // starting file, a movej + every point for a continuing one, one retract more at the end).
+    for (si, st) in plan.stations.iter().enumerate() {
+        let sizes: Vec<usize> = st.layers.iter().map(|l| l.waypoints.len()).collect();
+        let n = sizes.len();
+        let cost = |a: usize, b: usize| sizes[a..b].iter().sum::<usize>() + 1 + usize::from(b == n);
+        // All cuts into k files: recursive enumeration (n = 16 keeps it small).
+        fn cuts(n: usize, a: usize, k: usize, cur: &mut Vec<usize>, out: &mut Vec<Vec<usize>>) {
+            if k == 1 {
+                cur.push(n);
+                out.push(cur.clone());
+                cur.pop();
+                return;
+            }
+            for b in a + 1..n {
+                cur.push(b);
+                cuts(n, b, k - 1, cur, out);
+                cur.pop();
+            }
+        }
+        let mut best: Option<(usize, usize, usize)> = None;
+        for k in 1..=n {
+            let mut all = Vec::new();
+            cuts(n, 0, k, &mut Vec::new(), &mut all);
+            for c in &all {
+                let mut a = 0;
+                let mut files = Vec::new();
+                for &b in c {
+                    files.push(cost(a, b));
+                    a = b;
+                }
+                if files.iter().all(|&f| f <= 40) {
+                    let (mx, mn) = (*files.iter().max().unwrap(), *files.iter().min().unwrap());
+                    let key = (k, mx, usize::MAX - mn);
+                    if best.is_none_or(|b| key < b) {
+                        best = Some(key);
+                    }
+                }
+            }
+            if best.is_some() {
+                break;
+            }
+        }
+        let (k, mx, inv_mn) = best.unwrap();
+        let mine: Vec<usize> = plan
+            .parts
+            .iter()
+            .filter(|p| p.station == si)
+            .map(|p| p.targets)
+            .collect();
+        assert_eq!(mine.len(), k, "station {si}: {mine:?}");
+        assert_eq!(*mine.iter().max().unwrap(), mx, "station {si}: {mine:?}");
+        assert_eq!(
+            *mine.iter().min().unwrap(),
+            usize::MAX - inv_mn,
+            "station {si}: {mine:?}"
+        );
+    }
+    // No file of one layer at a station's end (the greedy cut's flaw).
+    assert!(
+        plan.parts.iter().all(|p| p.last > p.first),
+        "{:?}",
+        plan.parts
+    );
+    for f in program_files(&plan, "program_part").unwrap() {
+        let rep = lint(&f.text, 40);
+        assert!(
+            rep.ok() && rep.targets <= 40,
+            "{}: {:?}",
+            f.name,
+            rep.problems
+        );
+    }
+}
+
+#[test]
 fn waits_become_pauses_and_the_schedule_agrees() {
     let (layers, setup, mut opts) = small();
     opts.waits.min_layer_time = 5.0;
@@ -303,13 +387,14 @@ fn waits_become_pauses_and_the_schedule_agrees() {
     }
     // Given waits replace the minimum layer time; the programs sleep exactly those times.
     opts.waits.min_layer_time = 0.0;
+    // (Layer 1: inside the first of the two balanced files of 3 layers.)
     let waits = [LayerWait {
-        layer: 2,
+        layer: 1,
         wait: 7.5,
     }];
     let plan = plan_print_with_waits(&layers[..6], &setup, &opts, Some(&waits)).unwrap();
     let t = layer_times(&plan);
-    assert_eq!(t[2].wait, 7.5);
+    assert_eq!(t[1].wait, 7.5);
     let files = program_files(&plan, "p").unwrap();
     assert!(files.iter().any(|f| f.text.contains("sleep(7.500000)")));
     // Stopping the pump in pauses switches it on again after each.
@@ -487,4 +572,95 @@ fn plan_clears_ur_collision_meshes() {
     assert!(rep.meshes.self_distance.distance > 0.0);
     assert!(rep.capsules.environment.distance >= opts.clearance);
     assert!(rep.nozzle.distance >= opts.clearance);
+}
+
+/// Numbers inside the first `(...)` of a URScript call, e.g. `movep(p[1, 2, 3, …], a=…, v=…)`:
+/// the pose (or joint list) values and the named `v=`.
+fn pose_and_v(line: &str) -> (Vec<f64>, Option<f64>) {
+    let inner = line
+        .split_once('[')
+        .and_then(|(_, r)| r.split_once(']'))
+        .map_or("", |(p, _)| p);
+    let p: Vec<f64> = inner
+        .split(',')
+        .filter_map(|x| x.trim().parse().ok())
+        .collect();
+    let v = line
+        .split("v=")
+        .nth(1)
+        .and_then(|r| r.split([',', ')']).next())
+        .and_then(|x| x.trim().parse().ok());
+    (p, v)
+}
+
+#[test]
+fn one_clock_for_trajectory_schedule_programs_and_total() {
+    let (layers, setup, mut opts) = small();
+    // Waits (3 s per layer at least) and several files per station, so pauses and program
+    // changes are on the clock too.
+    opts.waits.min_layer_time = 3.0;
+    let plan = plan_print(&layers, &setup, &opts).unwrap();
+    let times = layer_times(&plan);
+    let rows = rows(&plan);
+    let files = program_files(&plan, "p").unwrap();
+    assert!(files.len() >= 3, "{}", files.len());
+    let last = times.last().unwrap();
+    // The total is the end of the last layer, the last row of trajectory.csv and the end of
+    // the last program: the same number, not within a tolerance.
+    assert_eq!(plan.total_time, last.end + last.pause);
+    assert_eq!(plan.total_time, rows.last().unwrap().t);
+    assert_eq!(plan.total_time, files.last().unwrap().end);
+    // The clock starts with the first program's approach: the first target is reached after it.
+    let approach = kappe_robot::timing::trapezoid_time(
+        opts.program.approach_distance,
+        opts.program.approach_speed,
+        opts.program.tool_acceleration,
+    );
+    assert_eq!(rows[0].t, approach);
+    // Every layer's start and end are its first and last rows.
+    for lt in &times {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.layer == lt.layer).collect();
+        assert_eq!(mine.first().unwrap().t, lt.start, "layer {}", lt.layer);
+        let end = mine.last().unwrap().t;
+        assert_eq!(end, lt.end + lt.pause, "layer {}", lt.layer);
+    }
+    // The programs' own time: per station, the sleeps plus every print move's length over its
+    // `v=`, plus the program switch between the station's files (the operator's time, on the
+    // plan's clock, not in a file), equals the station's span from its first to its last
+    // target.
+    for (si, st) in plan.stations.iter().enumerate() {
+        let mut prog_time = 0.0;
+        let mut prev: Option<[f64; 3]> = None;
+        let mine: Vec<&ProgramFile> = files.iter().filter(|f| f.part.station == si).collect();
+        for f in &mine {
+            let mut printing = false;
+            for line in f.text.lines().map(str::trim) {
+                if line.starts_with("movel(") && !printing && f.part.starts_station {
+                    // The approach's descent ends at the first target.
+                    prev = Some(pose_and_v(line).0[..3].try_into().unwrap());
+                    printing = true;
+                } else if line.starts_with("movep(") {
+                    printing = true;
+                    let (p, v) = pose_and_v(line);
+                    let p: [f64; 3] = p[..3].try_into().unwrap();
+                    let a = prev.unwrap();
+                    let d = ((p[0] - a[0]).powi(2) + (p[1] - a[1]).powi(2) + (p[2] - a[2]).powi(2))
+                        .sqrt();
+                    prog_time += d / v.unwrap();
+                    prev = Some(p);
+                } else if line.starts_with("sleep(") && printing {
+                    prog_time += line[6..line.len() - 1].parse::<f64>().unwrap();
+                }
+            }
+        }
+        prog_time += (mine.len() - 1) as f64 * opts.program.program_switch_time;
+        let first = st.layers[0].waypoints[0].t;
+        let span = st.layers.last().unwrap().waypoints.last().unwrap().t - first;
+        // Relative 1e-4: the programs round v to 1e-6 m/s (2e-5 of 0.05 m/s) and positions to
+        // 1e-9 m; the times themselves are exact.
+        assert!(
+            (prog_time - span).abs() <= 1e-4 * span,
+            "station {si}: programs {prog_time} s, plan {span} s"
+        );
+    }
 }

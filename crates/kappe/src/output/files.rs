@@ -1,0 +1,239 @@
+//! The files of a run, as names and bytes: what `kappe design` writes into its output
+//! directory, produced once for the CLI and the Python package.
+
+use kappe_robot::Plan;
+
+use super::{OutputError, Result};
+use crate::Outcome;
+
+/// One file of an output directory: its `/`-separated path relative to the directory, and its
+/// contents.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutputFile {
+    /// Relative path, e.g. `summary.json` or `bay_1/report.html`.
+    pub name: String,
+    /// The contents.
+    pub bytes: Vec<u8>,
+}
+
+impl OutputFile {
+    /// A file named `name` holding `bytes`.
+    pub fn new(name: impl Into<String>, bytes: impl Into<Vec<u8>>) -> Self {
+        Self {
+            name: name.into(),
+            bytes: bytes.into(),
+        }
+    }
+
+    /// The same file one directory down, under `dir/`.
+    #[must_use]
+    pub fn under(mut self, dir: &str) -> Self {
+        self.name = format!("{dir}/{}", self.name);
+        self
+    }
+}
+
+fn json(name: &str, value: &serde_json::Value) -> Result<OutputFile> {
+    serde_json::to_vec_pretty(value)
+        .map(|b| OutputFile::new(name, b))
+        .map_err(|e| OutputError::Produce(format!("cannot write {name}: {e}")))
+}
+
+/// The outputs of a timed robot plan: `trajectory.csv`, `plan.json` (what `kappe robot resume`
+/// reads), and when `programs` the controller-sized program files, each passing the independent
+/// URScript check against the plan's target limit, their index `programs.json`, and one combined
+/// `program.script` only when the whole print fits in one file.
+///
+/// # Errors
+/// [`OutputError::Produce`] when a program fails the URScript check or a writer fails (a bug in
+/// Kappe, not in the input).
+pub fn plan_files(plan: &Plan, prefix: &str, programs: bool) -> Result<Vec<OutputFile>> {
+    let produce = |e: kappe_robot::RobotError| OutputError::Produce(format!("robot outputs: {e}"));
+    let files = if programs {
+        kappe_robot::files::linted_programs(plan, prefix).map_err(produce)?
+    } else {
+        Vec::new()
+    };
+    let out = kappe_robot::files::plan_outputs(plan, &files).map_err(produce)?;
+    Ok(out
+        .into_iter()
+        // No index without programs.
+        .filter(|(name, _)| !files.is_empty() || name != "programs.json")
+        .map(|(name, bytes)| OutputFile::new(name, bytes))
+        .collect())
+}
+
+impl Outcome {
+    /// Every file `kappe design` writes for this outcome: `summary.json`, `network.json`,
+    /// `path.csv`, `cap.obj`, `cap.glb`, `report.html`, `schedule.csv`, and with a robot plan
+    /// its [`plan_files`] (programs only when [`Outcome::programs`] allows them).
+    ///
+    /// # Errors
+    /// [`OutputError::Produce`] when a file cannot be produced (see [`plan_files`]).
+    pub fn files(&self) -> Result<Vec<OutputFile>> {
+        let cap = &self.cap;
+        let network = crate::export::network_json(cap)
+            .map_err(|e| OutputError::Produce(format!("cannot write network.json: {e}")))?;
+        let report = self
+            .report_html()
+            .map_err(|e| OutputError::Produce(format!("cannot write report.html: {e}")))?;
+        let mut out = vec![
+            json("summary.json", &self.summary())?,
+            json("network.json", &network)?,
+            OutputFile::new("path.csv", cap.path.to_csv()),
+            OutputFile::new("cap.obj", cap.mesh.to_obj(&cap.design.name)),
+            OutputFile::new("cap.glb", cap.mesh.to_glb()),
+            OutputFile::new("report.html", report),
+        ];
+        // The layer times the structural check and the robot share (issue 11).
+        if let Ok(schedule) = self.schedule() {
+            out.push(OutputFile::new("schedule.csv", schedule.to_csv()));
+        }
+        if let Some(Ok(plan)) = &self.robot {
+            out.extend(plan_files(plan, "program_part", self.programs().is_ok())?);
+        }
+        Ok(out)
+    }
+
+    /// The table `kappe design` prints: the design, the layer arch, the states, the worst
+    /// stresses, overhang, thrust, path, material and print time, the analysis report and the
+    /// robot line; `out` is the output directory it names, `programs` the number of program
+    /// files written.
+    pub fn table(&self, out: &std::path::Path, programs: usize) -> String {
+        use std::fmt::Write;
+        let cap = &self.cap;
+        let d = &cap.design;
+        let fold = |f: fn(&crate::StateSummary) -> f64, init: f64, pick: fn(f64, f64) -> f64| {
+            cap.states.iter().map(f).fold(init, pick)
+        };
+        let worst_c = fold(|s| s.forces.max_compression_stress, 0.0, f64::min);
+        let worst_t = fold(|s| s.forces.max_tension_stress, 0.0, f64::max);
+        let worst_res = fold(|s| s.forces.max_residual, 0.0, f64::max);
+        let overhang = cap.overhangs.iter().fold(0.0_f64, |m, o| m.max(o.abs()));
+        let mut t = String::new();
+        let row = |t: &mut String, name: &str, value: String| {
+            let _ = writeln!(t, "  {name:<34} {value:>14}");
+        };
+        let _ = writeln!(t, "Kappe design \"{}\"", d.name);
+        let _ = writeln!(
+            t,
+            "  span {:.3} m, rise {:.3} m, length {:.3} m, tilt {:.1}°, lh {:.1} mm, lw {:.1} mm",
+            d.cap.span,
+            d.cap.rise,
+            d.cap.length,
+            d.cap.tilt_deg,
+            d.print.layer_height * 1e3,
+            d.print.layer_width * 1e3
+        );
+        let _ = writeln!(
+            t,
+            "  layer arch: {} segments of {:.2} mm, crown thrust {:.3} N (catenary a = {:.4} m)",
+            cap.arch.segments(),
+            cap.arch.segment_length * 1e3,
+            -cap.arch.crown_force,
+            cap.catenary.a
+        );
+        let _ = writeln!(
+            t,
+            "  layers: {} start + {} centre = {} states; final network {} nodes",
+            cap.sections.n_start,
+            cap.sections.n_centre,
+            cap.states.len(),
+            cap.final_state.network.nodes.len()
+        );
+        row(&mut t, "quantity", "value".into());
+        row(
+            &mut t,
+            "max compression stress [kPa]",
+            format!("{:.2}", worst_c / 1e3),
+        );
+        row(&mut t, "max tension stress [Pa]", format!("{worst_t:.3e}"));
+        row(&mut t, "max node residual [N]", format!("{worst_res:.3e}"));
+        row(
+            &mut t,
+            "max layer overhang [mm]",
+            format!("{:.2}", overhang * 1e3),
+        );
+        if let Some(s) = cap.states.last() {
+            row(
+                &mut t,
+                "start-section thrust on base [N]",
+                format!("{:.1}", s.forces.column_end_reaction[1]),
+            );
+            row(
+                &mut t,
+                "start-section H/V",
+                format!("{:.3}", s.forces.column_end_hv_ratio),
+            );
+        }
+        row(
+            &mut t,
+            "path length [m]",
+            format!("{:.2}", cap.path.print_length),
+        );
+        row(
+            &mut t,
+            "volume [l]",
+            format!("{:.2}", cap.path.volume * 1e3),
+        );
+        row(&mut t, "mass [kg]", format!("{:.1}", cap.path.mass));
+        row(
+            &mut t,
+            "print time [min]",
+            format!("{:.1}", self.print_time() / 60.0),
+        );
+        let _ = writeln!(
+            t,
+            "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb, report.html}}",
+            out.display()
+        );
+        if let Some(analysis) = &self.analysis {
+            for line in analysis.report().lines() {
+                let _ = writeln!(t, "  {line}");
+            }
+        }
+        let _ = match &self.robot {
+            Some(Ok(plan)) => writeln!(
+                t,
+                "  robot: {} station(s), joint motion {:.1} rad, {:.1} min, min clearance {:.1} mm, \
+                 {} slowdown(s); wrote trajectory.csv, plan.json{}",
+                plan.stations.len(),
+                plan.joint_motion,
+                self.print_time() / 60.0,
+                plan.min_clearance * 1e3,
+                plan.slowdowns.len(),
+                match self.programs() {
+                    Ok(_) => format!(", {programs} program(s) listed in programs.json"),
+                    Err(why) => format!("; no programs: {why}"),
+                }
+            ),
+            Some(Err(e)) => writeln!(t, "  robot: NOT PLANNED: {e}"),
+            None => writeln!(t, "  robot: planning skipped"),
+        };
+        t
+    }
+
+    /// Why the design fails, one line each (the robot, then every failing constraint), each
+    /// starting with `level` (`error`, or `warning` when failing is allowed).
+    pub fn failure_lines(&self, level: &str) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(Err(e)) = &self.robot {
+            lines.push(format!("{level}: the robot cannot print this design: {e}"));
+        }
+        if !self.ok {
+            for c in self.analysis.iter().flat_map(|a| a.failing()) {
+                lines.push(format!(
+                    "{level}: constraint {} fails: worst {} {} against the limit {} {}{}",
+                    c.name,
+                    c.worst.map_or("n/a".into(), |w| format!("{w:.4e}")),
+                    c.unit,
+                    c.limit,
+                    c.unit,
+                    c.state
+                        .map_or(String::new(), |s| format!(" (state {s}, {})", c.element))
+                ));
+            }
+        }
+        lines
+    }
+}
