@@ -1,8 +1,10 @@
 //! Analysis that scales (issue 15): the graded shell mesh (`kappe::window`) against the full
-//! mesh on the default cap: every checked state's BLF within 1 % and the same governing state.
+//! mesh on the default cap and on the 1.2 m cap: every checked state's BLF within 1 % and the
+//! same governing state.
 //!
-//! Every 8th state and the final one (15 of 113 states), so the test stays quick; the check of
-//! every state of the default and the 1.2 m cap is the example
+//! The default cap at every 8th state and the final one (15 of 113 states), the 1.2 m cap at
+//! every 24th and the final one (9 of 197), so the test stays quick; the check of every state of
+//! both is the example
 //! `cargo run --release -p kappe --example graded_check -- 0.6` (and `-- 1.2`), whose numbers
 //! are in the `kappe::window` docs.
 
@@ -10,11 +12,11 @@ use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
 use kappe::window::{Grading, graded_rows};
 use kappe::{Design, design_cap};
 
-fn blfs(d: &Design, grading: Option<Grading>) -> Vec<Option<f64>> {
+fn blfs(d: &Design, every: usize, grading: Option<Grading>) -> Vec<Option<f64>> {
     let cap = design_cap(d, &|_| {}).unwrap();
     let o = AnalysisOptions {
         modes: 1,
-        states: StateSelection::Every(8),
+        states: StateSelection::Every(every),
         grading,
         ..AnalysisOptions::default()
     };
@@ -37,11 +39,11 @@ fn governing(v: &[Option<f64>]) -> usize {
 
 #[test]
 fn graded_mesh_matches_the_full_mesh() {
-    for length in [0.6] {
+    for (length, every) in [(0.6, 8), (1.2, 24)] {
         let mut d = Design::default();
         d.cap.length = length;
-        let full = blfs(&d, None);
-        let graded = blfs(&d, Some(Grading::default()));
+        let full = blfs(&d, every, None);
+        let graded = blfs(&d, every, Some(Grading::default()));
         assert_eq!(full.len(), graded.len());
         let mut worst: f64 = 0.0;
         for (i, (a, b)) in full.iter().zip(&graded).enumerate() {
