@@ -2,7 +2,8 @@
 //!
 //! `cargo run --release -p kappe --example scaling [-- LENGTH ...]` (default 0.6 1.2 2.4 4.8):
 //! for each centre length, the default design with an end wall (`[cap] end = "end_wall"`, so
-//! long caps do not crush their start) and the graded shell mesh (`[analysis.grading]` with
+//! long caps do not crush their start; `KAPPE_END=start_section` for the default start section,
+//! the configuration of issue 15's baseline table) and the graded shell mesh (`[analysis.grading]` with
 //! its defaults), form-finding and the analysis of **every** state (stresses, overhang, shell
 //! buckling), each length in its own process so its peak memory (`VmHWM`) is its own. Prints the
 //! table and the least-squares exponent p of `analysis time ∝ length^p`, overall and over the
@@ -35,7 +36,11 @@ fn peak_mb() -> Option<f64> {
 fn one(length: f64) -> Result<(), Box<dyn std::error::Error>> {
     let mut d = kappe::Design::default();
     d.cap.length = length;
-    d.cap.end = kappe::ends::EndKind::EndWall;
+    if std::env::var("KAPPE_END").is_ok_and(|e| e == "start_section") {
+        d.cap.end = kappe::ends::EndKind::StartSection;
+    } else {
+        d.cap.end = kappe::ends::EndKind::EndWall;
+    }
     d.analysis.grading = Some(kappe::window::Grading::default());
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
