@@ -148,7 +148,8 @@ pub(crate) fn section_html(r: &RobotSummary) -> String {
             h,
             "<p class=\"hint\">Clearances of the capsule model the planner uses and of UR's convex collision meshes \
              (margins: {} to the environment, {} between links). “Along the motion” is a certified lower bound \
-             between the waypoints (joint travel × lever arm, split where it falls below the margin).</p>",
+             between the waypoints (joint travel × lever arm, split where it falls below the margin, so a value \
+             equal to the margin means the margin is proven, not that the arm is that close).</p>",
             mm(r.margin),
             mm(r.self_margin)
         );
@@ -165,11 +166,29 @@ pub(crate) fn section_html(r: &RobotSummary) -> String {
                 escape_html(&c.to),
                 mm(c.at_waypoints),
                 escape_html(&c.at),
-                c.along_motion.map_or_else(|| "–".to_string(), mm)
+                c.along_motion
+                    .map_or_else(|| "–".to_string(), |v| along_motion_text(c, v, r))
             );
         }
         let _ = writeln!(h, "</tbody></table>");
     }
     h.push_str("</section>\n");
     h
+}
+
+/// A certified bound is refined only until it clears the margin, so with a zero margin between
+/// links it stops just above 0: shown as "0.0 mm" it reads as contact, when it proves the
+/// opposite (a positive lower bound of the distance).
+fn along_motion_text(c: &ClearanceRow, v: f64, r: &RobotSummary) -> String {
+    let margin = if c.to == "self" {
+        r.self_margin
+    } else {
+        r.margin
+    };
+    // Below half of the 0.1 mm the table shows, a positive bound would print as "0.0 mm".
+    if margin == 0.0 && v > 0.0 && v < 0.05e-3 {
+        "&gt; 0: no contact (certified)".to_string()
+    } else {
+        mm(v)
+    }
 }

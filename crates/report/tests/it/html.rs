@@ -284,6 +284,26 @@ fn robot_section_shows_slowdowns_and_both_models_clearances() {
     // The clearance at the waypoints next to the certified bound along the motion.
     assert!(section.contains("55.5 mm"), "{section}");
     assert!(section.contains("31.0 mm"), "{section}");
+    // A self pair certified just above the zero margin between links proves no contact; it must
+    // not read as "0.0 mm". A larger bound is shown as a length.
+    {
+        let r = input.robot_summary.as_mut().unwrap();
+        for along in [2e-6, 0.004] {
+            r.clearances.push(kappe_report::ClearanceRow {
+                model: "arm meshes (UR)".into(),
+                to: "self".into(),
+                at_waypoints: 0.0402,
+                at: "upper_arm–wrist_3".into(),
+                along_motion: Some(along),
+            });
+        }
+    }
+    let html = render_html(&input).unwrap();
+    let rows = &html[html.find("id=\"clearance-table\"").unwrap()..];
+    assert!(rows.contains("no contact (certified)"), "{rows}");
+    assert!(rows.contains(">4.0 mm</td>"), "{rows}");
+    assert!(!rows.contains(">0.0 mm</td>"), "{rows}");
+    input.robot_summary.as_mut().unwrap().clearances.truncate(1);
     // No slowdown: one sentence with the design speed and the largest joint ratios.
     input.robot_summary.as_mut().unwrap().slowdowns.clear();
     let html = render_html(&input).unwrap();
