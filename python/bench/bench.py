@@ -28,7 +28,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from typing import List, Tuple
+from typing import Dict, List, Tuple
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = ROOT.parent / "shared" / "fixtures" / "cem" / "vault_grid500.input.json"
@@ -53,7 +53,7 @@ def child(cmd: List[str]) -> Tuple[float, float, float]:
 
 
 def design_rows(kappe_bin: str, repeat: int) -> None:
-    runs = {"cli": [], "py": [], "py_all": []}
+    runs: Dict[str, List[Tuple[float, float, float]]] = {"cli": [], "py": [], "py_all": []}
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(repeat):
             out = os.path.join(tmp, f"out{i}")

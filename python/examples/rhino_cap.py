@@ -5,23 +5,29 @@ The `# r: kappe` line above makes Rhino 8 install the package. Outside Rhino, `m
 same computation and returns the polylines instead of drawing them (the tests call it).
 """
 
+from typing import Any, List, Mapping, Optional, Tuple
+
 import kappe
 
+Point = Tuple[float, ...]
 
-def polylines(result):
+
+def polylines(result: kappe.Result) -> Tuple[List[List[Point]], List[Point]]:
     """The layers (one polyline per layer) and the print path, as lists of (x, y, z)."""
     layers = [[tuple(p) for p in layer.nodes] for layer in result.layers]
     path = [tuple(p) for p in result.path.points]
     return layers, path
 
 
-def main(design=None, robot=False):
+def main(
+    design: Optional[Mapping[str, Any]] = None, robot: bool = False
+) -> Tuple[kappe.Result, List[List[Point]], List[Point]]:
     d = kappe.Design(design or {})
     result = kappe.design(d, robot=robot, progress=lambda stage, done, total: None)
     layers, path = polylines(result)
     try:
-        import Rhino.Geometry as rg  # noqa: F401
-        import scriptcontext as sc
+        import Rhino.Geometry as rg  # type: ignore[import-not-found]  # noqa: F401
+        import scriptcontext as sc  # type: ignore[import-not-found]
     except ImportError:
         return result, layers, path
     for layer in layers:
@@ -32,5 +38,5 @@ def main(design=None, robot=False):
 
 
 if __name__ == "__main__":
-    r, _, _ = main()
+    r = main()[0]
     print(r, "mass", round(r.summary["mass_kg"], 2), "kg, ok:", r.ok)
