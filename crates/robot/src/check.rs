@@ -179,13 +179,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 ));
             }
         }
-        let mut prev: Option<Joints> = None;
-        for (o, l) in st.layers.iter().enumerate() {
-            let path: Vec<Joints> = prev
-                .into_iter()
-                .chain(l.waypoints.iter().map(|w| w.q))
-                .collect();
-            prev = l.waypoints.last().map(|w| w.q);
+        for (o, (l, path)) in st.layers.iter().zip(st.layer_paths()).enumerate() {
             motions.push((
                 path,
                 order + o,

@@ -459,14 +459,8 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
         // With every waypoint measured above (stride 1), a layer's rows are reused; only the
         // previous layer's end is measured again, with this layer's obstacles.
         let mut paths: Vec<LayerPath> = Vec::new();
-        let mut prev: Option<Joints> = None;
         let mut row = station_rows;
-        for (k, l) in st.layers.iter().enumerate() {
-            let path: Vec<Joints> = prev
-                .into_iter()
-                .chain(l.waypoints.iter().map(|w| w.q))
-                .collect();
-            prev = l.waypoints.last().map(|w| w.q);
+        for (k, (l, path)) in st.layers.iter().zip(st.layer_paths()).enumerate() {
             let rows = (stride == 1).then(|| row..row + l.waypoints.len());
             row += l.waypoints.len();
             paths.push((first_order + k, l.layer, path, rows));

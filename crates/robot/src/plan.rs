@@ -68,6 +68,26 @@ pub struct Station {
     pub layers: Vec<LayerPlan>,
 }
 
+impl Station {
+    /// The joint path of every layer's motion, in layer order: its waypoints, preceded (from the
+    /// second layer on) by the previous layer's last configuration, so the printed layer change
+    /// is part of the layer that it leads into.
+    pub fn layer_paths(&self) -> Vec<Vec<Joints>> {
+        let mut prev: Option<Joints> = None;
+        self.layers
+            .iter()
+            .map(|l| {
+                let path: Vec<Joints> = prev
+                    .into_iter()
+                    .chain(l.waypoints.iter().map(|w| w.q))
+                    .collect();
+                prev = l.waypoints.last().map(|w| w.q);
+                path
+            })
+            .collect()
+    }
+}
+
 /// A verified-ready plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
