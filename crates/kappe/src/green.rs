@@ -491,23 +491,15 @@ impl CapGreen {
         if self.time.strength.is_none() {
             return Ok(None);
         }
-        let graded;
-        let (reduced, node_map) = match &options.grading {
-            Some(g) => {
-                graded = crate::window::graded_state_map(state, g);
-                (&graded.0, Some(&graded.1))
-            }
-            None => (state, None),
-        };
-        let Ok(shell) = crate::shell::state_shell(reduced, material, options.row_stride) else {
+        let analysed = crate::window::AnalysedState::new(state, options.grading.as_ref());
+        let Ok(shell) = crate::shell::state_shell(analysed.state(), material, options.row_stride)
+        else {
             return Ok(None);
         };
         let (b, mut mode, st) =
             crate::analysis::buckling::shell_buckling_full(&shell, state.index, options)?;
-        if let Some(map) = node_map {
-            for (k, _) in &mut mode {
-                *k = map.get(*k).copied().unwrap_or(*k);
-            }
+        for (k, _) in &mut mode {
+            *k = analysed.full_index(*k).unwrap_or(*k);
         }
         let worst = st.map(|st| self.stress_checks_on(&shell, &st, top));
         Ok(Some((b, mode, worst)))

@@ -363,6 +363,45 @@ pub fn graded_state(state: &State, g: &Grading) -> State {
     graded_state_map(state, g).0
 }
 
+/// The network a state's shell analysis meshes: the state itself, or with a grading its graded
+/// reduction ([`graded_state_map`]) together with the way back to the state's own nodes, so the
+/// buckling and the green-state checks report modes and places on the state's network.
+pub enum AnalysedState<'a> {
+    /// Every layer is a mesh row.
+    Full(&'a State),
+    /// The kept rows, and for each of their nodes its index in the state's network.
+    Graded(State, Vec<usize>),
+}
+
+impl<'a> AnalysedState<'a> {
+    /// `state` as the analysis with `grading` meshes it.
+    pub fn new(state: &'a State, grading: Option<&Grading>) -> Self {
+        match grading {
+            Some(g) => {
+                let (reduced, map) = graded_state_map(state, g);
+                AnalysedState::Graded(reduced, map)
+            }
+            None => AnalysedState::Full(state),
+        }
+    }
+
+    /// The network to mesh.
+    pub fn state(&self) -> &State {
+        match self {
+            AnalysedState::Full(s) => s,
+            AnalysedState::Graded(s, _) => s,
+        }
+    }
+
+    /// The index in the state's own network of node `k` of [`Self::state`].
+    pub fn full_index(&self, k: usize) -> Option<usize> {
+        match self {
+            AnalysedState::Full(_) => Some(k),
+            AnalysedState::Graded(_, map) => map.get(k).copied(),
+        }
+    }
+}
+
 /// Indices `0 = i_0 < … < i_m = len − 1` of the nodes a row of `len` nodes keeps when thinned by
 /// `c`: m = ⌈(len − 1)/c⌉ nearly equal steps (so no sliver at the far foot).
 fn thinned(len: usize, c: usize) -> Vec<usize> {

@@ -126,15 +126,8 @@ pub fn state_buckling_warm(
 ) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
     // A graded mesh (issue 15, `crate::window`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
-    let graded;
-    let (reduced, node_map) = match &options.grading {
-        Some(g) => {
-            graded = crate::window::graded_state_map(state, g);
-            (&graded.0, Some(&graded.1))
-        }
-        None => (state, None),
-    };
-    let shell = match state_shell(reduced, material, options.row_stride) {
+    let analysed = crate::window::AnalysedState::new(state, options.grading.as_ref());
+    let shell = match state_shell(analysed.state(), material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
             return Ok((
@@ -150,7 +143,6 @@ pub fn state_buckling_warm(
             ));
         }
     };
-    let full_index = |k: usize| node_map.map_or(Some(k), |m| m.get(k).copied());
     // First network index of every layer: the network stores each layer contiguously.
     let mut first: HashMap<i32, usize> = HashMap::new();
     for (i, n) in state.network.nodes.iter().enumerate() {
@@ -162,7 +154,7 @@ pub fn state_buckling_warm(
         .network_node
         .iter()
         .map(|&k| {
-            let i = full_index(k)?;
+            let i = analysed.full_index(k)?;
             let layer = state.network.nodes.get(i)?.layer;
             Some((layer, i.checked_sub(*first.get(&layer)?)?))
         })
@@ -180,7 +172,7 @@ pub fn state_buckling_warm(
     let (b, mode, full, _) = shell_buckling_run(&shell, state.index, options, start)?;
     let mode = mode
         .into_iter()
-        .map(|(k, d)| (full_index(k).unwrap_or(k), d))
+        .map(|(k, d)| (analysed.full_index(k).unwrap_or(k), d))
         .collect();
     let next = full
         .map(|m| {
