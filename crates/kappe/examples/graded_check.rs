@@ -26,6 +26,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 max_stride: *v.get(1)?,
                 zone_rows: v.get(2).copied().unwrap_or(d.zone_rows),
                 transverse: v.get(3).copied().unwrap_or(d.transverse),
+                start_stride: v.get(4).copied().unwrap_or(d.start_stride),
+                ..d
             })
         })
         .collect();

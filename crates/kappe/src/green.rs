@@ -171,31 +171,6 @@ pub fn check_state(
 /// next state's eigensolve ([`check_state_warm`]).
 pub type ModeStart = Vec<[f64; 6]>;
 
-/// The warm start plus a seeded pseudo-random vector of the same size: the previous mode alone
-/// can miss the lowest one (a cylinder's circumferential harmonics are orthogonal, so a start
-/// of one wave number never picks up another); the random part keeps every mode in the Krylov
-/// space while the guess still shortens the iteration.
-fn with_noise(mut start: ModeStart) -> ModeStart {
-    let scale = start
-        .iter()
-        .flatten()
-        .fold(0.0_f64, |m, v| m.max(v.abs()))
-        .max(f64::MIN_POSITIVE);
-    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
-    for v in start.iter_mut().flatten() {
-        // xorshift64*: deterministic, uniform in [−1, 1).
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        let r = (x.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
-        *v += scale * NOISE * (2.0 * r - 1.0);
-    }
-    start
-}
-
-/// Size of the random part of a warm start relative to the guess's largest entry.
-const NOISE: f64 = 0.1;
-
 /// [`check_state`] with the Lanczos iteration started from `start` (e.g. the previous state's
 /// mode mapped onto this mesh) and this state's mode returned for the next one. The start saves
 /// steps only: the result meets the same residual bound (`kappe_fe::BucklingOptions::start`).
@@ -226,7 +201,9 @@ pub fn check_state_warm(
             modes: 1,
             tolerance: options.tolerance,
             sturm_check: false,
-            start: start.map(with_noise),
+            // `kappe_fe` blends the start with seeded noise (a cylinder's circumferential
+            // harmonics are orthogonal: a start of one wave number alone never finds another).
+            start,
             ..Default::default()
         };
         match kappe_fe::buckling(model, &opts) {
@@ -477,10 +454,10 @@ impl CapGreen {
     /// nodes either way. `None` without a strength model or without a shell (a single layer):
     /// the caller's plain buckling path then covers the state.
     ///
-    /// On a graded mesh an element spanning several layers carries their mean membrane stress
-    /// and is checked with the age of its upper (younger, weaker) row: the stress peak at a
-    /// coarse row is smoothed, its strength taken low (`tests/green_state.rs` states how far
-    /// from the full mesh this lands).
+    /// On a graded mesh ([`crate::window::Grading::for_stresses`]) an element spanning several
+    /// layers carries their mean membrane stress and is checked with the age of its upper
+    /// (younger, weaker) row: the stress peak at a coarse row is smoothed, its strength taken low
+    /// (`tests/green_state.rs` states how far from the full mesh this lands).
     pub fn state_checks(
         &self,
         state: &crate::states::State,
@@ -491,7 +468,12 @@ impl CapGreen {
         if self.time.strength.is_none() {
             return Ok(None);
         }
-        let analysed = crate::window::AnalysedState::new(state, options.grading.as_ref());
+        // Stresses are checked here too: the grading's finer zones for stresses.
+        let grading = options
+            .grading
+            .as_ref()
+            .map(crate::window::Grading::for_stresses);
+        let analysed = crate::window::AnalysedState::new(state, grading.as_ref());
         let Ok(shell) = crate::shell::state_shell(analysed.state(), material, options.row_stride)
         else {
             return Ok(None);

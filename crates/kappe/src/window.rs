@@ -16,18 +16,36 @@
 //! two keeping the facets about square, at most `transverse`). The shell's DOFs then grow like
 //! `fine + zone_rows·log2(max_stride) + depth/max_stride` rows instead of `depth`.
 //!
+//! **The supports set the grading, not the depth.** A start layer's feet stand on the base
+//! plane, each pinned: a coarse row in the start section leaves that support line pinned only
+//! every few layers. That, not the depth, is where coarse gradings lost their accuracy: on the
+//! 1.2 m cap, zone rows 4 are 1.8 % off with the start section graded like the rest and 0.15 %
+//! with every start layer a row ([`Grading::start_stride`] 1); on an end-wall cap (no start
+//! section) zone rows 4 are 0.15–0.51 % off. The start section has a fixed number of layers, so
+//! keeping it whole costs the same at every length, while four zone rows instead of twelve make
+//! the per-state mesh stop growing early (issue 15's cost exponent, `examples/scaling.rs`).
+//!
 //! Rows are anchored at print index 0 (a row is kept when its index is a multiple of its stride),
 //! so the mesh of a state is the previous state's mesh less a few rows plus the new top layer:
 //! [`crate::analysis::analyze`] starts each state's Lanczos iteration from the previous state's
 //! mode ([`crate::analysis::buckling::state_buckling_warm`]), about 30 % fewer CPU seconds.
+//! (`kappe_fe` blends the start with seeded noise: the previous mode alone once made a 4.8 m
+//! cap's state converge to its second mode, 2 % high.)
 //!
-//! **Checked against the full mesh** (`examples/graded_check.rs`, every state, the analysis as
-//! `kappe design` runs it, release): with the default grading (fine 32, max stride 32, zone rows
-//! 12, transverse 4) the largest BLF difference over every state is 0.22 % (state 67) on the
-//! default cap and 0.56 % (state 79) on the 1.2 m cap, and the governing state is the same
-//! (112 and 196; its BLF 0.07 % and 0.17 % high). Coarser zones are cheaper and less accurate
-//! (1.2 m cap): zone rows 8 give 0.84 %, 4 give 1.8 %; fine 24 gives 1.1 %. `tests/scale.rs`
-//! repeats the check on every 8th state of the default cap.
+//! **Checked against the full mesh** (`examples/graded_check.rs`, the analysis as `kappe design`
+//! runs it, release) with the default grading (fine 32, max stride 32, zone rows 4, transverse 2,
+//! start stride 1), largest BLF difference and where, the governing state the same in each:
+//!
+//! | cap | states checked | largest difference | governing state, BLF graded / full |
+//! |---|---|---|---|
+//! | default (0.6 m, start section) | all 113 | 0.085 % (state 108) | 112, 3.6028 / 3.6025 |
+//! | 1.2 m, start section | all 197 | 0.15 % (state 160) | 196, 2.3969 / 2.3970 |
+//! | 1.2 m, end wall | all 136 | 0.15 % (state 64) | 135, 3.3740 / 3.3739 |
+//! | 4.8 m, end wall | every 4th of 544 | 0.26 % (state 520) | 543, 1.5519 / 1.5481 |
+//!
+//! The previous default (zone rows 12, transverse 4, the start section graded) was 0.22 %,
+//! 0.56 %, 0.16 % and 0.40 %. `tests/scale.rs` repeats the check on every 8th state of the
+//! default cap and every 24th of the 1.2 m cap.
 //!
 //! Independent of the element: the graded state is the state's network reduced to the kept rows,
 //! meshed by [`crate::shell::state_shell`] with whatever element it uses. Hand-written: the row
@@ -308,6 +326,18 @@ pub struct Grading {
     /// c the largest power of two with c·Δs ≤ s·pitch (near-square facets; Δs the node spacing
     /// along the layer, pitch the spacing of the layers), at most `transverse`. 1: off.
     pub transverse: usize,
+    /// Largest stride in the start section (layers with id < 0). Their feet stand on the base
+    /// plane, pinned one per layer: a coarse row there leaves the support line pinned only
+    /// every few layers, which is where a coarse grading loses its accuracy (module docs). The
+    /// start section has a fixed number of layers, so this costs the same at every length.
+    pub start_stride: usize,
+    /// Zone rows when the shell's membrane stresses are checked too (a strength model in
+    /// `[material.time]`): a stress peak is local where the BLF is an integral over the shell, so
+    /// the coarse zones start deeper ([`Self::for_stresses`]). Against the full mesh on a 0.6 m
+    /// cap with linear E(t) and Mohr–Coulomb strength, the largest strength difference is 24 %
+    /// (over, the safe side) with 4 zone rows, 4.5 % with 6, 2.1 % with 10 and under 2 % with 12
+    /// (`tests/green_state.rs`).
+    pub stress_zone_rows: usize,
 }
 
 impl Default for Grading {
@@ -317,8 +347,10 @@ impl Default for Grading {
         Grading {
             fine: 32,
             max_stride: 32,
-            zone_rows: 12,
-            transverse: 4,
+            zone_rows: 4,
+            transverse: 2,
+            start_stride: 1,
+            stress_zone_rows: 12,
         }
     }
 }
@@ -342,17 +374,42 @@ impl Grading {
         }
         max_stride
     }
+
+    /// The grading for a shell whose membrane stresses are checked as well as its BLF: at least
+    /// [`Self::stress_zone_rows`] rows per zone.
+    pub fn for_stresses(&self) -> Grading {
+        Grading {
+            zone_rows: self.zone_rows.max(self.stress_zone_rows),
+            ..*self
+        }
+    }
+
+    /// The stride of a row `depth` layers below the top, in the start section or not: the
+    /// smaller of [`Self::stride_at`] and, in the start section, the largest power of two not
+    /// above `start_stride`.
+    pub fn row_stride(&self, depth: usize, in_start: bool) -> usize {
+        let s = self.stride_at(depth);
+        if !in_start {
+            return s;
+        }
+        let mut cap = 1usize;
+        while 2 * cap <= self.start_stride.max(1) {
+            cap *= 2;
+        }
+        s.min(cap)
+    }
 }
 
-/// Which of `n` rows (print order, the last is the newest) a graded mesh keeps: a row `d`
-/// layers below the top is kept when its print index is a multiple of
-/// [`Grading::stride_at`]`(d)`; the first row (on the bed or the wall) and the top row always.
+/// Which of `n` rows (print order, the last is the newest; the first `start_rows` are the start
+/// section's) a graded mesh keeps: a row `d` layers below the top is kept when its print index is
+/// a multiple of [`Grading::row_stride`]; the first row (on the bed or the wall) and the top row
+/// always.
 /// The rows are anchored at print index 0, not at the top, so the kept rows of a state are the
 /// kept rows of the previous state less a few and plus the new top layer (strides only grow with
 /// depth and are powers of two): the previous state's mode is a good start for this one.
-pub fn graded_rows(n: usize, g: &Grading) -> Vec<bool> {
+pub fn graded_rows(n: usize, start_rows: usize, g: &Grading) -> Vec<bool> {
     (0..n)
-        .map(|q| q == 0 || q.is_multiple_of(g.stride_at(n - 1 - q)))
+        .map(|q| q == 0 || q.is_multiple_of(g.row_stride(n - 1 - q, q < start_rows)))
         .collect()
 }
 
@@ -420,7 +477,8 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
     let net = &state.network;
     let rows = crate::shell::layer_rows(net);
     let n = rows.len();
-    let keep = graded_rows(n, g);
+    let start_rows = rows.iter().take_while(|(id, _)| *id < 0).count();
+    let keep = graded_rows(n, start_rows, g);
     // Δs and the layer pitch at the top (both are uniform along the cap).
     let pitch_ratio = match (rows.last(), n.checked_sub(2).and_then(|k| rows.get(k))) {
         (Some((_, top)), Some((_, below))) if top.len() >= 2 && top.len() == below.len() => {
@@ -445,7 +503,7 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
         if !*k {
             continue;
         }
-        let stride = g.stride_at(n - 1 - q);
+        let stride = g.row_stride(n - 1 - q, q < start_rows);
         let mut c = 1usize;
         while 2 * c <= g.transverse.max(1)
             && (2 * c) as f64 <= stride as f64 * pitch_ratio
