@@ -15,7 +15,9 @@
 //! their base-pose tolerance checked. Issue 15's target is the 1.5 m × 4 m bay.
 //!
 //! CPU time and the load average are printed next to the wall times so figures taken on a
-//! shared machine can be read.
+//! shared machine can be read. `KAPPE_REPEAT=N` runs every length N times (in rounds over the
+//! lengths) and reports the median, with the spread: single runs on this machine scatter by
+//! ±10 %.
 
 use std::process::Command;
 use std::time::Instant;
@@ -134,42 +136,61 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         args.iter().map(|a| a.parse()).collect::<Result<_, _>>()?
     };
     let exe = std::env::current_exe()?;
+    // Repeats run in rounds over all lengths (so a slow spell of the machine spreads over the
+    // lengths); each length reports its median run.
+    let repeat: usize = std::env::var("KAPPE_REPEAT")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1)
+        .max(1);
+    let mut runs: Vec<Vec<(f64, Vec<String>, String)>> = vec![Vec::new(); lengths.len()];
+    for _ in 0..repeat {
+        for (k, l) in lengths.iter().enumerate() {
+            let out = Command::new(&exe).arg("one").arg(l.to_string()).output()?;
+            let text = String::from_utf8_lossy(&out.stdout);
+            let Some(row) = text.lines().find_map(|r| r.strip_prefix("ROW ")) else {
+                println!(
+                    "| {l} | error: {} |",
+                    String::from_utf8_lossy(&out.stderr).trim()
+                );
+                continue;
+            };
+            let f: Vec<String> = row.split_whitespace().map(str::to_string).collect();
+            if f.len() < 10 {
+                continue;
+            }
+            let analysis: f64 = f[4].parse()?;
+            runs[k].push((analysis, f, measure::load_average()));
+        }
+    }
     println!(
-        "| centre length m | states | final nodes | form-finding s | analysis s (every state) | of which force passes + stresses s | of which shell buckling s | CPU s | peak MB | load | verdict |"
+        "| centre length m | states | final nodes | form-finding s | analysis s (every state; median of {repeat}, min–max) | of which force passes + stresses s | of which shell buckling s | CPU s | peak MB | load | verdict |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let (mut xs, mut ts) = (Vec::new(), Vec::new());
-    for l in &lengths {
-        let out = Command::new(&exe).arg("one").arg(l.to_string()).output()?;
-        let text = String::from_utf8_lossy(&out.stdout);
-        let Some(row) = text.lines().find_map(|r| r.strip_prefix("ROW ")) else {
-            println!(
-                "| {l} | error: {} |",
-                String::from_utf8_lossy(&out.stderr).trim()
-            );
+    for (l, r) in lengths.iter().zip(&mut runs) {
+        r.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let (Some(lo), Some(hi)) = (r.first(), r.last()) else {
             continue;
         };
-        let f: Vec<&str> = row.split_whitespace().collect();
-        if f.len() < 10 {
+        let (lo, hi) = (lo.0, hi.0);
+        let Some((analysis, f, load)) = r.get(r.len() / 2) else {
             continue;
-        }
-        let analysis: f64 = f[4].parse()?;
+        };
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {analysis:.2} ({lo:.2}–{hi:.2}) | {} | {} | {} | {} | {load} | {} |",
             f[0],
             f[1],
             f[2],
             f[3],
-            f[4],
             f[8],
             f[9],
             f[5],
             f[6],
-            measure::load_average(),
             if f[7] == "true" { "pass" } else { "fail" }
         );
         xs.push(*l);
-        ts.push(analysis);
+        ts.push(*analysis);
     }
     if xs.len() >= 2 {
         let n = xs.len();
@@ -178,6 +199,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             exponent(&xs, &ts),
             exponent(&xs[n - 2..], &ts[n - 2..])
         );
+        // Issue 15's range, when the run covers it and more.
+        let k = xs.iter().position(|&x| x > 4.8 + 1e-9).unwrap_or(n);
+        if k >= 2 && k < n {
+            println!(
+                "exponent over {}–{} m: {:.2}",
+                xs[0],
+                xs[k - 1],
+                exponent(&xs[..k], &ts[..k])
+            );
+        }
     }
     Ok(())
 }
