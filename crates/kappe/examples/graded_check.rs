@@ -1,7 +1,8 @@
 //! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::window`).
 //!
-//! `cargo run --release -p kappe --example graded_check -- LENGTH [FINE:MAX_STRIDE[:ZONE_ROWS[:TRANSVERSE]]] ...`
-//! (e.g. `1.2 32:32:8:4`; no grading given: the default one): per grading, the largest relative
+//! `cargo run --release -p kappe --example graded_check -- LENGTH [FINE:MAX_STRIDE[:ZONE_ROWS[:TRANSVERSE[:START_STRIDE]]]] ...`
+//! (e.g. `1.2 32:32:8:4:1`; fields left out take the default grading's values; no grading given:
+//! the default one): per grading, the largest relative
 //! BLF difference over the checked states, the governing state and BLF, and the buckling wall
 //! time (`kappe::analysis::analyze`, so the graded runs are warm-started as in `kappe design`),
 //! against the full mesh. Environment: `KAPPE_END=end_wall` for an end-wall cap,
@@ -72,7 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         argmin(&full)
     );
     println!(
-        "| fine:max_stride:zone_rows:transverse | max rel BLF diff | at state | governing (state, BLF) | FE s |"
+        "| fine:max_stride:zone_rows:transverse:start_stride | max rel BLF diff | at state | governing (state, BLF) | FE s |"
     );
     println!("|---|---|---|---|---|");
     for g in &gradings {
@@ -87,11 +88,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
         println!(
-            "| {}:{}:{}:{} | {:.3e} | {} | {:?} | {t:.2} |",
+            "| {}:{}:{}:{}:{} | {:.3e} | {} | {:?} | {t:.2} |",
             g.fine,
             g.max_stride,
             g.zone_rows,
             g.transverse,
+            g.start_stride,
             worst.0,
             worst.1,
             argmin(&v)

@@ -12,7 +12,9 @@ use super::buckling::{
     state_buckling_warm, state_material_with,
 };
 use super::options::AnalysisOptions;
-use super::stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
+use super::stress::{
+    STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
+};
 use crate::error::DesignError;
 use crate::pipeline::Cap;
 use crate::states::build_state;
@@ -149,31 +151,6 @@ impl Analysis {
     }
 }
 
-/// The extremes of one state's element stresses: the first element with the lowest and with the
-/// highest stress (the order `element_stresses` gives), and the largest |σ|.
-#[derive(Debug, Clone, Copy, Default)]
-struct StressExtremes {
-    min: Option<(f64, ElementKind)>,
-    max: Option<(f64, ElementKind)>,
-    abs_max: f64,
-}
-
-impl StressExtremes {
-    fn of(stresses: &[ElementStress]) -> Self {
-        let mut e = StressExtremes::default();
-        for s in stresses {
-            if e.min.is_none_or(|m| s.stress < m.0) {
-                e.min = Some((s.stress, s.kind));
-            }
-            if e.max.is_none_or(|m| s.stress > m.0) {
-                e.max = Some((s.stress, s.kind));
-            }
-            e.abs_max = e.abs_max.max(s.stress.abs());
-        }
-        e
-    }
-}
-
 #[derive(Debug, Clone)]
 struct Worst {
     value: f64,
@@ -273,28 +250,54 @@ pub(crate) fn analyze_scheduled(
     // `[material.time]` gives a strength model (otherwise nothing changes).
     let green = crate::green::CapGreen::with_schedule(cap, schedule)?;
     let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
-    // Phase 1: every state's force pass and element stresses (cheap).
+    // Phase 1: every state's force pass and element stresses (cheap). Against an end wall the
+    // final state's force pass gives every state's extremes (`extremes_by_depth`: linear, not
+    // quadratic, in the bay length).
     let t_phase = Instant::now();
-    let mut per: Vec<PerState> = (0..total)
-        .into_par_iter()
-        .map(|top| {
-            cancelled()?;
-            let t0 = Instant::now();
-            let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-            // Only the extremes are kept: all element stresses of every state would take memory
-            // quadratic in the bay length (0.7 GB for a 4 m bay).
-            let stresses = StressExtremes::of(&element_stresses(&state, areas)?);
-            Ok(PerState {
+    let by_depth = match total.checked_sub(1) {
+        Some(last) if depth_invariant(&cap.sections) => {
+            let state = build_state(&cap.sections, &cap.frame, phi, last)?;
+            extremes_by_depth(&cap.sections, &element_stresses(&state, areas)?)
+        }
+        _ => None,
+    };
+    let mut per: Vec<PerState> = if let Some(extremes) = by_depth {
+        let secs = t_phase.elapsed().as_secs_f64() / total.max(1) as f64;
+        extremes
+            .into_iter()
+            .enumerate()
+            .map(|(top, stresses)| PerState {
                 stresses,
-                stress_seconds: t0.elapsed().as_secs_f64(),
+                stress_seconds: secs,
                 buckling: None,
                 mode: Vec::new(),
                 fe_seconds: 0.0,
-                top_layer: state.top_layer,
+                top_layer: cap.sections.layers.get(top).map_or(0, |l| l.id),
                 green: None,
             })
-        })
-        .collect::<Result<_, DesignError>>()?;
+            .collect()
+    } else {
+        (0..total)
+            .into_par_iter()
+            .map(|top| {
+                cancelled()?;
+                let t0 = Instant::now();
+                let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+                // Only the extremes are kept: all element stresses of every state would take memory
+                // quadratic in the bay length (0.7 GB for a 4 m bay).
+                let stresses = StressExtremes::of(&element_stresses(&state, areas)?);
+                Ok(PerState {
+                    stresses,
+                    stress_seconds: t0.elapsed().as_secs_f64(),
+                    buckling: None,
+                    mode: Vec::new(),
+                    fe_seconds: 0.0,
+                    top_layer: state.top_layer,
+                    green: None,
+                })
+            })
+            .collect::<Result<_, DesignError>>()?
+    };
     let wall_stresses = t_phase.elapsed().as_secs_f64();
     // Phase 2: the buckling analysis of the selected states, largest first so the two cores
     // finish together.

@@ -7,8 +7,10 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
+use crate::ends::EndKind;
 use crate::error::DesignError;
 use crate::forces::{Sections2D, state_forces};
+use crate::section::Sections;
 use crate::states::{Role, State};
 
 /// Relative tolerance on stress limits: a stress passes if it is within `1e-9·max|σ|` of its
@@ -134,4 +136,277 @@ pub fn element_stresses(
         });
     }
     Ok(out)
+}
+
+/// The extremes of one state's element stresses: the first element with the lowest and with the
+/// highest stress (the order [`element_stresses`] gives), and the largest |σ|.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct StressExtremes {
+    pub(crate) min: Option<(f64, ElementKind)>,
+    pub(crate) max: Option<(f64, ElementKind)>,
+    pub(crate) abs_max: f64,
+}
+
+impl StressExtremes {
+    pub(crate) fn of(stresses: &[ElementStress]) -> Self {
+        let mut e = StressExtremes::default();
+        for s in stresses {
+            e.add(s.stress, s.kind);
+        }
+        e
+    }
+
+    /// Take `stress` of `kind` as the next element in order (the first of equal values stays).
+    fn add(&mut self, stress: f64, kind: ElementKind) {
+        if self.min.is_none_or(|m| stress < m.0) {
+            self.min = Some((stress, kind));
+        }
+        if self.max.is_none_or(|m| stress > m.0) {
+            self.max = Some((stress, kind));
+        }
+        self.abs_max = self.abs_max.max(stress.abs());
+    }
+}
+
+/// Extremes of one element family at one depth: (value, index within the family at that depth).
+#[derive(Debug, Clone, Copy)]
+struct DepthExtremes {
+    min: (f64, usize),
+    max: (f64, usize),
+}
+
+impl DepthExtremes {
+    fn merge(a: Option<Self>, b: Option<Self>) -> Option<(Self, bool, bool)> {
+        // Returns the merged extremes and, for min and max, whether `b` supplied them.
+        match (a, b) {
+            (None, None) => None,
+            (Some(a), None) => Some((a, false, false)),
+            (None, Some(b)) => Some((b, true, true)),
+            (Some(a), Some(b)) => {
+                let min_b = b.min.0 < a.min.0;
+                let max_b = b.max.0 > a.max.0;
+                Some((
+                    DepthExtremes {
+                        min: if min_b { b.min } else { a.min },
+                        max: if max_b { b.max } else { a.max },
+                    },
+                    min_b,
+                    max_b,
+                ))
+            }
+        }
+    }
+}
+
+/// Whether every state's layer forces depend only on the layer's depth below the state's top:
+/// against an end wall, with no start section ([`extremes_by_depth`]).
+pub(crate) fn depth_invariant(sections: &Sections) -> bool {
+    sections.end == EndKind::EndWall && sections.n_start == 0
+}
+
+/// The stress extremes of **every** state of an end-wall cap from one force pass, that of the
+/// final state (`final_stresses`, [`element_stresses`] of it); `None` when the cap has a start
+/// section (its layers' forces depend on the state), so the caller runs every state's force pass.
+///
+/// Why it is exact: the force pass sweeps each column from the top down (method.md §5), so a
+/// layer's forces depend only on the layers above it, and against an end wall every layer is
+/// layer 0 translated by k·step, with the same loads and arch forces. So in every state the
+/// layer d layers below the top carries the forces of the final state's layer at depth d, and the
+/// bed joint under the state's layer 0 (on the wall) carries what the final state's bed joint at
+/// that depth carries (both run along −step). The extremes of state `t` are then prefix extremes
+/// over the depths 0..=t: O(1) per state instead of a force pass over the whole state, which
+/// made checking every state quadratic in the bay length (issue 15). The values agree with the
+/// per-state force passes to round-off (the translated coordinates differ in their last bits;
+/// `tests` compares every state); among elements of equal stress the one named may then differ
+/// (e.g. an arch's mirror column).
+pub(crate) fn extremes_by_depth(
+    sections: &Sections,
+    final_stresses: &[ElementStress],
+) -> Option<Vec<StressExtremes>> {
+    if !depth_invariant(sections) {
+        return None;
+    }
+    let n = sections.layers.len();
+    let id_of = |q: usize| sections.layers.get(q).map(|l| l.id);
+    let top_id = id_of(n.checked_sub(1)?)?;
+    // Depth in the final state of the layer with id `id` (print index = id without a start).
+    let depth = |id: i32| -> Option<usize> {
+        let d = top_id.checked_sub(id)?;
+        usize::try_from(d).ok().filter(|&d| d < n)
+    };
+    // Per depth: arch segments (in order) and the column edges below the layer (in order).
+    let mut arch: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
+    let mut below: Vec<Vec<f64>> = vec![Vec::new(); n];
+    for s in final_stresses {
+        match s.kind {
+            ElementKind::ArchSegment { layer, segment } => {
+                arch.get_mut(depth(layer)?)?.push((s.stress, segment));
+            }
+            ElementKind::BedJoint { upper, .. } => below.get_mut(depth(upper)?)?.push(s.stress),
+            ElementKind::WallJoint { layer } => below.get_mut(depth(layer)?)?.push(s.stress),
+            ElementKind::ColumnFoot { .. } => return None,
+        }
+    }
+    let fold = |v: &[(f64, usize)]| -> Option<DepthExtremes> {
+        let mut e: Option<DepthExtremes> = None;
+        for &(x, i) in v {
+            e = Some(match e {
+                None => DepthExtremes {
+                    min: (x, i),
+                    max: (x, i),
+                },
+                Some(mut e) => {
+                    if x < e.min.0 {
+                        e.min = (x, i);
+                    }
+                    if x > e.max.0 {
+                        e.max = (x, i);
+                    }
+                    e
+                }
+            });
+        }
+        e
+    };
+    let arch_at: Vec<Option<DepthExtremes>> = arch.iter().map(|v| fold(v)).collect();
+    let below_at: Vec<Option<DepthExtremes>> = below
+        .iter()
+        .map(|v| {
+            let idx: Vec<(f64, usize)> = v.iter().copied().zip(0..).collect();
+            fold(&idx)
+        })
+        .collect();
+    let abs = |e: Option<DepthExtremes>| e.map_or(0.0, |e| e.min.0.abs().max(e.max.0.abs()));
+    // Prefix extremes over depths, remembering the depth that supplied each.
+    type Prefix = Option<(DepthExtremes, usize, usize)>;
+    let prefix = |at: &[Option<DepthExtremes>]| -> Vec<Prefix> {
+        let mut out = Vec::with_capacity(at.len());
+        let mut acc: Prefix = None;
+        for (d, e) in at.iter().enumerate() {
+            acc = match DepthExtremes::merge(acc.map(|a| a.0), *e) {
+                None => None,
+                Some((m, min_b, max_b)) => {
+                    let (dmin, dmax) = acc.map_or((d, d), |a| (a.1, a.2));
+                    Some((
+                        m,
+                        if min_b { d } else { dmin },
+                        if max_b { d } else { dmax },
+                    ))
+                }
+            };
+            out.push(acc);
+        }
+        out
+    };
+    let arch_prefix = prefix(&arch_at);
+    let below_prefix = prefix(&below_at);
+    let mut abs_arch = Vec::with_capacity(n);
+    let mut abs_below = Vec::with_capacity(n);
+    let (mut a, mut b) = (0.0_f64, 0.0_f64);
+    for d in 0..n {
+        a = a.max(abs(arch_at[d]));
+        b = b.max(abs(below_at[d]));
+        abs_arch.push(a);
+        abs_below.push(b);
+    }
+    let mut out = Vec::with_capacity(n);
+    for t in 0..n {
+        let state_id = |d: usize| id_of(t.checked_sub(d)?);
+        let mut e = StressExtremes::default();
+        // The generic order: arch segments (top layer first), then the column edges.
+        if let Some((m, dmin, dmax)) = arch_prefix[t] {
+            e.add(
+                m.min.0,
+                ElementKind::ArchSegment {
+                    layer: state_id(dmin)?,
+                    segment: m.min.1,
+                },
+            );
+            e.add(
+                m.max.0,
+                ElementKind::ArchSegment {
+                    layer: state_id(dmax)?,
+                    segment: m.max.1,
+                },
+            );
+        }
+        let bed = |d: usize| -> Option<ElementKind> {
+            Some(ElementKind::BedJoint {
+                upper: state_id(d)?,
+                lower: state_id(d + 1)?,
+            })
+        };
+        if let Some((m, dmin, dmax)) = t.checked_sub(1).and_then(|d| below_prefix[d]) {
+            e.add(m.min.0, bed(dmin)?);
+            e.add(m.max.0, bed(dmax)?);
+        }
+        // The state's layer 0 stands on the wall.
+        if let Some(w) = below_at[t] {
+            let wall = ElementKind::WallJoint {
+                layer: state_id(t)?,
+            };
+            e.add(w.min.0, wall);
+            e.add(w.max.0, wall);
+        }
+        e.abs_max = abs_arch[t]
+            .max(if t > 0 { abs_below[t - 1] } else { 0.0 })
+            .max(abs(below_at[t]));
+        out.push(e);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::states::build_state;
+
+    /// Every state's extremes from the final state's force pass equal those of the state's own
+    /// force pass (end-wall caps of 0.3 and 0.6 m, every state). Tolerance 1e-12 of the state's
+    /// largest |σ|: the two differ only by the round-off of the translated coordinates in the
+    /// unit vectors (1e-16 relative each, summed down at most a few hundred layers). Where the
+    /// named element differs, the state's own pass gives it the same stress (a tie, e.g. the
+    /// mirror column of a symmetric arch).
+    #[test]
+    fn extremes_by_depth_equal_every_states_own_force_pass() {
+        for length in [0.3, 0.6] {
+            let mut d = crate::Design::default();
+            d.cap.length = length;
+            d.cap.end = EndKind::EndWall;
+            let cap = crate::design_cap(&d, &|_| {}).expect("cap");
+            let phi = d.print.start_arch_fraction;
+            let n = cap.sections.layers.len();
+            let last = build_state(&cap.sections, &cap.frame, phi, n - 1).expect("state");
+            let fast = extremes_by_depth(
+                &cap.sections,
+                &element_stresses(&last, cap.areas()).expect("stresses"),
+            )
+            .expect("an end-wall cap is depth-invariant");
+            assert_eq!(fast.len(), n);
+            for (top, f) in fast.iter().enumerate() {
+                let state = build_state(&cap.sections, &cap.frame, phi, top).expect("state");
+                let all = element_stresses(&state, cap.areas()).expect("stresses");
+                let own = StressExtremes::of(&all);
+                let tol = 1e-12 * own.abs_max.max(1.0);
+                assert!((f.abs_max - own.abs_max).abs() <= tol, "state {top}");
+                for (a, b) in [(f.min, own.min), (f.max, own.max)] {
+                    let (Some(a), Some(b)) = (a, b) else {
+                        panic!("state {top}: {a:?} vs {b:?}");
+                    };
+                    assert!((a.0 - b.0).abs() <= tol, "state {top}: {a:?} vs {b:?}");
+                    if a.1 != b.1 {
+                        let named = all.iter().find(|s| s.kind == a.1);
+                        assert!(
+                            named.is_some_and(|s| (s.stress - b.0).abs() <= tol),
+                            "state {top}: {a:?} names an element the state does not have at {b:?}"
+                        );
+                    }
+                }
+            }
+        }
+        // A start section: the forces of its layers depend on the state, so no shortcut.
+        let cap = crate::design_cap(&crate::Design::default(), &|_| {}).expect("cap");
+        assert!(!depth_invariant(&cap.sections));
+        assert!(extremes_by_depth(&cap.sections, &[]).is_none());
+    }
 }
