@@ -48,7 +48,8 @@
 //! The previous default (zone rows 12, max stride 32, transverse 4, the start section graded)
 //! was 0.22 %, 0.56 %, 0.16 % and 0.40 % on the first four. Max stride 32 instead of 128 gives
 //! 0.26 % at 4.8 m and 0.29 % at 9.6 m, but a row per 32 layers below the zones, so the mesh
-//! keeps growing with the depth (4.8 → 9.6 m: ×2.3 analysis time instead of ×2.2).
+//! keeps growing with the depth; with 128 the 9.6 m cap's states 100 … 1087 have 2,045 … 2,445
+//! shell nodes at the same cost (`examples/analysis_bench.rs profile`).
 //! `tests/scale.rs` repeats the check on every 8th state of the default cap, every 24th of the
 //! 1.2 m cap and every 24th of the 1.2 m end-wall cap.
 //!
