@@ -398,11 +398,7 @@ impl Grading {
         if !in_start {
             return s;
         }
-        let mut cap = 1usize;
-        while 2 * cap <= self.start_stride.max(1) {
-            cap *= 2;
-        }
-        s.min(cap)
+        s.min(1usize << self.start_stride.max(1).ilog2())
     }
 }
 

@@ -168,33 +168,36 @@ impl StressExtremes {
     }
 }
 
-/// Extremes of one element family at one depth: (value, index within the family at that depth).
+/// The first lowest and first highest of a run of elements of one family, each as (σ, depth,
+/// index of the element within the family at that depth); merged in element order.
 #[derive(Debug, Clone, Copy)]
-struct DepthExtremes {
-    min: (f64, usize),
-    max: (f64, usize),
+struct FamilyExtremes {
+    min: (f64, usize, usize),
+    max: (f64, usize, usize),
 }
 
-impl DepthExtremes {
-    fn merge(a: Option<Self>, b: Option<Self>) -> Option<(Self, bool, bool)> {
-        // Returns the merged extremes and, for min and max, whether `b` supplied them.
-        match (a, b) {
-            (None, None) => None,
-            (Some(a), None) => Some((a, false, false)),
-            (None, Some(b)) => Some((b, true, true)),
-            (Some(a), Some(b)) => {
-                let min_b = b.min.0 < a.min.0;
-                let max_b = b.max.0 > a.max.0;
-                Some((
-                    DepthExtremes {
-                        min: if min_b { b.min } else { a.min },
-                        max: if max_b { b.max } else { a.max },
-                    },
-                    min_b,
-                    max_b,
-                ))
-            }
+impl FamilyExtremes {
+    fn one(item: (f64, usize, usize)) -> Self {
+        FamilyExtremes {
+            min: item,
+            max: item,
         }
+    }
+
+    /// `a` then `b` in element order: on equal values the earlier element stays.
+    fn merge(a: Option<Self>, b: Option<Self>) -> Option<Self> {
+        match (a, b) {
+            (Some(a), Some(b)) => Some(FamilyExtremes {
+                min: if b.min.0 < a.min.0 { b.min } else { a.min },
+                max: if b.max.0 > a.max.0 { b.max } else { a.max },
+            }),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// The largest |σ| of the run.
+    fn abs_max(e: Option<Self>) -> f64 {
+        e.map_or(0.0, |e| e.min.0.abs().max(e.max.0.abs()))
     }
 }
 
@@ -234,101 +237,59 @@ pub(crate) fn extremes_by_depth(
         let d = top_id.checked_sub(id)?;
         usize::try_from(d).ok().filter(|&d| d < n)
     };
-    // Per depth: arch segments (in order) and the column edges below the layer (in order).
+    // Per depth, in element order: arch segments (σ, segment) and the column edges below the
+    // layer (σ, their index at that depth).
     let mut arch: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
-    let mut below: Vec<Vec<f64>> = vec![Vec::new(); n];
+    let mut below: Vec<Vec<(f64, usize)>> = vec![Vec::new(); n];
     for s in final_stresses {
-        match s.kind {
-            ElementKind::ArchSegment { layer, segment } => {
-                arch.get_mut(depth(layer)?)?.push((s.stress, segment));
+        let (family, d, i) = match s.kind {
+            ElementKind::ArchSegment { layer, segment } => (&mut arch, depth(layer)?, segment),
+            ElementKind::BedJoint { upper: layer, .. } | ElementKind::WallJoint { layer } => {
+                let d = depth(layer)?;
+                let i = below.get(d)?.len();
+                (&mut below, d, i)
             }
-            ElementKind::BedJoint { upper, .. } => below.get_mut(depth(upper)?)?.push(s.stress),
-            ElementKind::WallJoint { layer } => below.get_mut(depth(layer)?)?.push(s.stress),
             ElementKind::ColumnFoot { .. } => return None,
-        }
+        };
+        family.get_mut(d)?.push((s.stress, i));
     }
-    let fold = |v: &[(f64, usize)]| -> Option<DepthExtremes> {
-        let mut e: Option<DepthExtremes> = None;
-        for &(x, i) in v {
-            e = Some(match e {
-                None => DepthExtremes {
-                    min: (x, i),
-                    max: (x, i),
-                },
-                Some(mut e) => {
-                    if x < e.min.0 {
-                        e.min = (x, i);
-                    }
-                    if x > e.max.0 {
-                        e.max = (x, i);
-                    }
-                    e
-                }
-            });
-        }
-        e
+    // Per depth, then over the depths 0..=d (the elements of a state whose top is d deep).
+    let at = |v: &[Vec<(f64, usize)>]| -> Vec<Option<FamilyExtremes>> {
+        v.iter()
+            .enumerate()
+            .map(|(d, xs)| {
+                xs.iter().fold(None, |e, &(x, i)| {
+                    FamilyExtremes::merge(e, Some(FamilyExtremes::one((x, d, i))))
+                })
+            })
+            .collect()
     };
-    let arch_at: Vec<Option<DepthExtremes>> = arch.iter().map(|v| fold(v)).collect();
-    let below_at: Vec<Option<DepthExtremes>> = below
-        .iter()
-        .map(|v| {
-            let idx: Vec<(f64, usize)> = v.iter().copied().zip(0..).collect();
-            fold(&idx)
-        })
-        .collect();
-    let abs = |e: Option<DepthExtremes>| e.map_or(0.0, |e| e.min.0.abs().max(e.max.0.abs()));
-    // Prefix extremes over depths, remembering the depth that supplied each.
-    type Prefix = Option<(DepthExtremes, usize, usize)>;
-    let prefix = |at: &[Option<DepthExtremes>]| -> Vec<Prefix> {
-        let mut out = Vec::with_capacity(at.len());
-        let mut acc: Prefix = None;
-        for (d, e) in at.iter().enumerate() {
-            acc = match DepthExtremes::merge(acc.map(|a| a.0), *e) {
-                None => None,
-                Some((m, min_b, max_b)) => {
-                    let (dmin, dmax) = acc.map_or((d, d), |a| (a.1, a.2));
-                    Some((
-                        m,
-                        if min_b { d } else { dmin },
-                        if max_b { d } else { dmax },
-                    ))
-                }
-            };
-            out.push(acc);
-        }
-        out
+    let prefix = |at: &[Option<FamilyExtremes>]| -> Vec<Option<FamilyExtremes>> {
+        at.iter()
+            .scan(None, |acc, e| {
+                *acc = FamilyExtremes::merge(*acc, *e);
+                Some(*acc)
+            })
+            .collect()
     };
-    let arch_prefix = prefix(&arch_at);
+    let arch_prefix = prefix(&at(&arch));
+    let below_at = at(&below);
     let below_prefix = prefix(&below_at);
-    let mut abs_arch = Vec::with_capacity(n);
-    let mut abs_below = Vec::with_capacity(n);
-    let (mut a, mut b) = (0.0_f64, 0.0_f64);
-    for d in 0..n {
-        a = a.max(abs(arch_at[d]));
-        b = b.max(abs(below_at[d]));
-        abs_arch.push(a);
-        abs_below.push(b);
-    }
     let mut out = Vec::with_capacity(n);
     for t in 0..n {
         let state_id = |d: usize| id_of(t.checked_sub(d)?);
         let mut e = StressExtremes::default();
         // The generic order: arch segments (top layer first), then the column edges.
-        if let Some((m, dmin, dmax)) = arch_prefix[t] {
-            e.add(
-                m.min.0,
-                ElementKind::ArchSegment {
-                    layer: state_id(dmin)?,
-                    segment: m.min.1,
-                },
-            );
-            e.add(
-                m.max.0,
-                ElementKind::ArchSegment {
-                    layer: state_id(dmax)?,
-                    segment: m.max.1,
-                },
-            );
+        if let Some(m) = arch_prefix[t] {
+            for (x, d, segment) in [m.min, m.max] {
+                e.add(
+                    x,
+                    ElementKind::ArchSegment {
+                        layer: state_id(d)?,
+                        segment,
+                    },
+                );
+            }
         }
         let bed = |d: usize| -> Option<ElementKind> {
             Some(ElementKind::BedJoint {
@@ -336,21 +297,24 @@ pub(crate) fn extremes_by_depth(
                 lower: state_id(d + 1)?,
             })
         };
-        if let Some((m, dmin, dmax)) = t.checked_sub(1).and_then(|d| below_prefix[d]) {
-            e.add(m.min.0, bed(dmin)?);
-            e.add(m.max.0, bed(dmax)?);
+        let above_wall = t.checked_sub(1).and_then(|d| below_prefix[d]);
+        if let Some(m) = above_wall {
+            for (x, d, _) in [m.min, m.max] {
+                e.add(x, bed(d)?);
+            }
         }
         // The state's layer 0 stands on the wall.
         if let Some(w) = below_at[t] {
             let wall = ElementKind::WallJoint {
                 layer: state_id(t)?,
             };
-            e.add(w.min.0, wall);
-            e.add(w.max.0, wall);
+            for (x, _, _) in [w.min, w.max] {
+                e.add(x, wall);
+            }
         }
-        e.abs_max = abs_arch[t]
-            .max(if t > 0 { abs_below[t - 1] } else { 0.0 })
-            .max(abs(below_at[t]));
+        e.abs_max = FamilyExtremes::abs_max(arch_prefix[t])
+            .max(FamilyExtremes::abs_max(above_wall))
+            .max(FamilyExtremes::abs_max(below_at[t]));
         out.push(e);
     }
     Some(out)
