@@ -43,10 +43,10 @@ fn status_of_cause(cause: &(dyn std::error::Error + 'static)) -> Option<u8> {
     if cause.is::<Usage>() {
         return Some(USAGE);
     }
-    kappe::error::class_of(cause).map(|class| match class {
-        kappe::error::Class::Input => USAGE,
-        kappe::error::Class::Fails => FAILS,
-        kappe::error::Class::Internal => INTERNAL,
+    kappe::class::class_of(cause).map(|class| match class {
+        kappe::class::Class::Input => USAGE,
+        kappe::class::Class::Fails => FAILS,
+        kappe::class::Class::Internal => INTERNAL,
     })
 }
 

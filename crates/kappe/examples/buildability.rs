@@ -14,7 +14,7 @@ use measure::{cpu_seconds, load_average};
 
 use rayon::prelude::*;
 
-use kappe::buildability::{BuildabilitySpec, EXAMPLE_TOML, run};
+use kappe::commands::buildability::{BuildabilitySpec, EXAMPLE_TOML, run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let r = BuildabilitySpec::from_toml_str(EXAMPLE_TOML)?;
@@ -82,7 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (t0, c0) = (Instant::now(), cpu_seconds().unwrap_or(f64::NAN));
     let cold: Vec<_> = (1..=60)
         .into_par_iter()
-        .map(|n| kappe::buildability::check_layers(&r60, n))
+        .map(|n| kappe::commands::buildability::check_layers(&r60, n))
         .collect::<Result<_, _>>()?;
     println!(
         "baseline, every state from a random start: {:.2} s wall, {:.2} s CPU, load average {}",

@@ -10,9 +10,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use kappe::analysis::shell::state_shell;
 use kappe::analysis::{AnalysisOptions, state_material};
-use kappe::shell::state_shell;
-use kappe::states::build_state;
+use kappe::form::states::build_state;
 use kappe_fe::{BucklingOptions, ElementKind, ShellModel, ccx};
 
 fn deck(m: &ShellModel, scale: f64) -> String {

@@ -1,4 +1,4 @@
-//! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::window`).
+//! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::analysis::window`).
 //!
 //! `cargo run --release -p kappe --example graded_check -- LENGTH [FINE:MAX_STRIDE[:ZONE_ROWS[:TRANSVERSE[:START_STRIDE]]]] ...`
 //! (e.g. `1.2 32:32:8:4:1`; fields left out take the default grading's values; no grading given:
@@ -9,8 +9,8 @@
 //! `KAPPE_STATES=every:N` to check every N-th state only (long caps), `KAPPE_NO_FULL=1` to time
 //! the gradings alone.
 
+use kappe::analysis::window::Grading;
 use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
-use kappe::window::Grading;
 use kappe::{Design, design_cap};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut d = Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "end_wall") {
-        d.cap.end = kappe::ends::EndKind::EndWall;
+        d.cap.end = kappe::form::ends::EndKind::EndWall;
     }
     let states: StateSelection = std::env::var("KAPPE_STATES")
         .ok()

@@ -39,11 +39,11 @@ fn one(length: f64) -> Result<(), Box<dyn std::error::Error>> {
     let mut d = kappe::Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "start_section") {
-        d.cap.end = kappe::ends::EndKind::StartSection;
+        d.cap.end = kappe::form::ends::EndKind::StartSection;
     } else {
-        d.cap.end = kappe::ends::EndKind::EndWall;
+        d.cap.end = kappe::form::ends::EndKind::EndWall;
     }
-    d.analysis.grading = Some(kappe::window::Grading::default());
+    d.analysis.grading = Some(kappe::analysis::window::Grading::default());
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
     let cap = kappe::design_cap(&d, &|_| {})?;
@@ -81,13 +81,15 @@ fn bay(span: f64, length: f64) -> Result<(), Box<dyn std::error::Error>> {
          rise_ratio = 0.25\ntilt_deg = 25.0\n[[bay]]\nname = \"bay\"\nspan = {span}\n\
          [analysis.grading]\n"
     );
-    let c = kappe::ceiling::CeilingDesign::from_toml_str(&text)?;
+    let c = kappe::commands::ceiling::CeilingDesign::from_toml_str(&text)?;
     let designs = c.bay_designs()?;
     let first = designs.first().ok_or("no bay")?;
     let options = kappe::Options::of(first);
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
-    let b = kappe::ceiling::run_bay(&c, 0, &options, &|_| std::ops::ControlFlow::Continue(()))?;
+    let b = kappe::commands::ceiling::run_bay(&c, 0, &options, &|_| {
+        std::ops::ControlFlow::Continue(())
+    })?;
     let total = t.elapsed().as_secs_f64();
     let cpu = measure::cpu_seconds().unwrap_or(0.0) - cpu0;
     let analysis = b.outcome.analysis.as_ref();

@@ -11,9 +11,9 @@ use std::time::Instant;
 fn ceiling(file: Option<&String>) -> Result<(), Box<dyn std::error::Error>> {
     let text = match file {
         Some(f) => std::fs::read_to_string(f)?,
-        None => kappe::ceiling::EXAMPLE_TOML.to_string(),
+        None => kappe::commands::ceiling::EXAMPLE_TOML.to_string(),
     };
-    let c = kappe::ceiling::CeilingDesign::from_toml_str(&text)?;
+    let c = kappe::commands::ceiling::CeilingDesign::from_toml_str(&text)?;
     let designs = c.bay_designs()?;
     let first = designs.first().ok_or("no bay")?;
     let options = kappe::Options::of(first);
@@ -25,8 +25,9 @@ fn ceiling(file: Option<&String>) -> Result<(), Box<dyn std::error::Error>> {
     let mut bays = Vec::new();
     for i in 0..designs.len() {
         let t = Instant::now();
-        let bay =
-            kappe::ceiling::run_bay(&c, i, &options, &|_| std::ops::ControlFlow::Continue(()))?;
+        let bay = kappe::commands::ceiling::run_bay(&c, i, &options, &|_| {
+            std::ops::ControlFlow::Continue(())
+        })?;
         let total = t.elapsed().as_secs_f64();
         let fe = bay
             .outcome
@@ -43,7 +44,7 @@ fn ceiling(file: Option<&String>) -> Result<(), Box<dyn std::error::Error>> {
         );
         bays.push(bay);
     }
-    let out = kappe::ceiling::CeilingOutcome::from_bays(&c, bays);
+    let out = kappe::commands::ceiling::CeilingOutcome::from_bays(&c, bays);
     println!(
         "ceiling: {} bays, {:.1} s, {}",
         out.bays.len(),

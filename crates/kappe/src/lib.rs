@@ -1,48 +1,33 @@
 //! # kappe: the 3D-printed cap ceiling
 //!
-//! The method of the paper (`cap-ceiling-paper.txt`) made precise in `method.md`:
-//! a design spec ([`Design`]) → the layer arch form-found with constrained CEM ([`arch`]) →
-//! the centre and start sections ([`section`]) → the network of every print state ([`states`]),
-//! its forces from CEM's fixed-geometry force pass → the print path ([`path`]) and the bead mesh
-//! ([`mesh`]).
+//! The method of the paper (`cap-ceiling-paper.txt`) made precise in `method.md`. The modules
+//! are the floors of the data flow; each imports only the floors before it:
+//!
+//! | floor | module | holds |
+//! |---|---|---|
+//! | 0 | [`input`] | the design and its option tables (plain data, parse, validate), the errors |
+//! | 1 | [`form`] | layer arch (CEM), sections, ends, print states and forces, overhang, path, beads |
+//! | 2 | [`robot_plan`] | the UR10e plan of the print path (stations, timing, programs' input) |
+//! | 3 | [`schedule`] | the one clock: every layer's start and end, so its age in every state |
+//! | 4 | [`analysis`] | every state's stresses, shell buckling and green-state checks |
+//! | 5 | [`verdict`] | pass or fail, from the domain results |
+//! | 6 | [`run`] | the pipeline of one design: form → plan → schedule → analysis → verdict |
+//! | 7 | [`output`] | `summary.json`, `network.json`, the report input, the files, the safe writer |
+//! | 8 | [`commands`] | study, ceiling, optimize, least waits, calibrations, buildability |
+//!
+//! [`class`] sorts every crate's errors for whoever reports them (exit status, exception).
 
 pub mod analysis;
-pub mod arch;
-pub mod buildability;
-pub mod calibrate;
-pub mod ceiling;
-pub mod design_loop;
-pub mod ends;
-pub mod error;
-pub mod evaluate;
-pub mod export;
-pub mod forces;
-pub mod frame;
-pub mod green;
-pub mod material;
-pub mod mesh;
+pub mod class;
+pub mod commands;
+pub mod form;
+pub mod input;
 pub mod output;
-pub mod path;
-pub mod pipeline;
-pub mod print_calibration;
-pub mod report_input;
 pub mod robot_plan;
+pub mod run;
 pub mod schedule;
-pub mod section;
-pub mod shell;
-pub mod spec;
-pub mod states;
-pub mod study;
-pub mod templates;
 pub mod verdict;
-pub mod wait_search;
-pub mod window;
 
-/// The analysis under its old name (`kappe::constraints`), for code written before the split;
-/// use [`analysis`].
-#[doc(hidden)]
-pub use analysis as constraints;
-pub use error::DesignError;
-pub use evaluate::{Options, Outcome, Progress, Stage, evaluate, no_progress, run};
-pub use pipeline::{Cap, StateSummary, design_cap};
-pub use spec::Design;
+pub use form::{Cap, StateSummary, design_cap};
+pub use input::{Design, DesignError};
+pub use run::{Options, Outcome, Progress, Stage, evaluate, no_progress, run};

@@ -5,8 +5,8 @@
 use kappe_robot::Plan;
 use kappe_robot::setup::{PathPoint as RobotPoint, PrintLayer, beams};
 
-use crate::path::PrintPath;
-use crate::pipeline::Cap;
+use crate::form::cap::Cap;
+use crate::form::path::PrintPath;
 
 /// The print targets grouped by layer, in print order (the `layer,index` of `path.csv`).
 pub fn print_layers(path: &PrintPath) -> Vec<PrintLayer> {
@@ -64,13 +64,13 @@ const END_WALL_THICKNESS: f64 = 0.25;
 /// How far the end wall reaches beyond the beams' outer faces and above the crown, m.
 const END_WALL_MARGIN: f64 = 0.5;
 
-/// The end wall of an end-wall cap (issue 15, `crate::ends`) as a robot obstacle: a vertical
+/// The end wall of an end-wall cap (issue 15, `crate::form::ends`) as a robot obstacle: a vertical
 /// box behind the wall face, from the floor (or the beams' underside) to `END_WALL_MARGIN` above
 /// the crown, its front face through the crown of the inclined bearing plane (the point of the
 /// face farthest back: the vertical gable wall, with the inclined wedge in front of it below the
 /// crown, which lies behind layer 0 and so never in the robot's way). None for other ends.
 fn end_wall(cap: &Cap, floor_z: Option<f64>) -> Option<kappe_robot::collision::Obstacle> {
-    if cap.design.cap.end != crate::ends::EndKind::EndWall {
+    if cap.design.cap.end != crate::form::ends::EndKind::EndWall {
         return None;
     }
     let face_y = cap
@@ -78,7 +78,7 @@ fn end_wall(cap: &Cap, floor_z: Option<f64>) -> Option<kappe_robot::collision::O
         .network
         .nodes
         .iter()
-        .filter(|n| n.role == crate::states::Role::ColumnEnd)
+        .filter(|n| n.role == crate::form::states::Role::ColumnEnd)
         .map(|n| n.xyz.y)
         .fold(f64::INFINITY, f64::min);
     if !face_y.is_finite() {

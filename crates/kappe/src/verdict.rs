@@ -9,8 +9,8 @@
 
 use kappe_report::{Bound, ConstraintRow};
 
-use crate::pipeline::{Cap, StateSummary};
-use crate::report_input::ReportExtras;
+use crate::form::cap::{Cap, StateSummary};
+use crate::output::report_input::ReportExtras;
 
 /// Relative tolerance on stress limits. The fixed-geometry force pass balances every node to
 /// ~1e-14 relative (method.md §9), so an arch whose forces are all compressive in exact

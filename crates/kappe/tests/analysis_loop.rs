@@ -1,8 +1,10 @@
 //! Calibration (paper §3.3) and the design loop (`kappe optimize`).
 
 use kappe::Design;
-use kappe::calibrate::{Evidence, Outcome, PrototypeFile, Resolved, calibrate, derive};
-use kappe::design_loop::{OptimizeFile, optimize};
+use kappe::commands::calibrate_blf::{
+    Evidence, Outcome, PrototypeFile, Resolved, calibrate, derive,
+};
+use kappe::commands::optimize::{OptimizeFile, optimize};
 
 fn evidence(name: &str, outcome: Outcome, survived: Option<f64>, failed: Option<f64>) -> Evidence {
     Evidence {

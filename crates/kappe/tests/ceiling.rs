@@ -1,7 +1,9 @@
 //! A three-bay ceiling end to end at a small size (issue 15): every bay designed, every state
 //! analysed, both halves planned, the ceiling summary and the room's report.
 
-use kappe::ceiling::{BayEnds, CeilingDesign, EXAMPLE_TOML, is_ceiling_toml, run_ceiling};
+use kappe::commands::ceiling::{
+    BayEnds, CeilingDesign, EXAMPLE_TOML, is_ceiling_toml, run_ceiling,
+};
 
 /// The three-bay room shared with the other ceiling tests.
 const SMALL: &str = include_str!(concat!(
@@ -20,7 +22,7 @@ fn three_bay_ceiling_end_to_end() {
         let am = d.tilt();
         let expect = 0.25 - d.cap.rise * am.tan() - d.print.layer_height / am.cos();
         assert!((d.cap.length - expect).abs() < 1e-12);
-        assert_eq!(d.cap.end, kappe::ends::EndKind::EndWall);
+        assert_eq!(d.cap.end, kappe::form::ends::EndKind::EndWall);
     }
     let out = run_ceiling(&c, &kappe::Options::of(&designs[0]), &|_, _| {
         std::ops::ControlFlow::Continue(())

@@ -1,13 +1,13 @@
-//! Ends that carry the thrust (issue 15, `kappe::ends`): the end wall takes the stack thrust of
+//! Ends that carry the thrust (issue 15, `kappe::form::ends`): the end wall takes the stack thrust of
 //! method.md §5, column by column, checked against the closed form and by equilibrium.
 
 use kappe::Design;
-use kappe::arch::{ArchSpec, form_find_layer};
-use kappe::ends::{EndKind, stack_thrust, wall_load};
-use kappe::forces::{Sections2D, state_forces};
-use kappe::frame::{LayerFrame, V3};
-use kappe::section::{NodeKind, Sections, build_sections_with_end};
-use kappe::states::{Role, build_state};
+use kappe::form::arch::{ArchSpec, form_find_layer};
+use kappe::form::ends::{EndKind, stack_thrust, wall_load};
+use kappe::form::forces::{Sections2D, state_forces};
+use kappe::form::frame::{LayerFrame, V3};
+use kappe::form::section::{NodeKind, Sections, build_sections_with_end};
+use kappe::form::states::{Role, build_state};
 
 /// The sections of `d` with the given end, built as the pipeline builds them.
 fn sections(d: &Design, end: EndKind) -> (Sections, LayerFrame, Sections2D) {

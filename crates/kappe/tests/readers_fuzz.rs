@@ -104,8 +104,8 @@ proptest! {
     fn design_reader_survives_random_bytes(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
         let text = String::from_utf8_lossy(&bytes);
         let _ = kappe::Design::from_toml_str(&text);
-        let _ = kappe::design_loop::OptimizeFile::from_any_toml_str(&text);
-        let _ = kappe::calibrate::PrototypeFile::from_toml_str(&text);
+        let _ = kappe::commands::optimize::OptimizeFile::from_any_toml_str(&text);
+        let _ = kappe::commands::calibrate_blf::PrototypeFile::from_toml_str(&text);
     }
 
     #[test]

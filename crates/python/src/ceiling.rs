@@ -1,14 +1,14 @@
 //! Ceilings from Python (issue 15): one bay per call, so a cluster can run the bays of a room
 //! as separate tasks, and the room assembled from the bays' rows on the client — the same
-//! library functions `kappe design ROOM.toml` calls ([`kappe::ceiling::run_bay`],
-//! [`kappe::ceiling::ceiling_summary`], [`kappe::ceiling::index_html`]). Also the safe output
+//! library functions `kappe design ROOM.toml` calls ([`kappe::commands::ceiling::run_bay`],
+//! [`kappe::commands::ceiling::ceiling_summary`], [`kappe::commands::ceiling::index_html`]). Also the safe output
 //! writer ([`kappe::output`]) for every `write()` of the Python package.
 
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
-use kappe::ceiling::CeilingDesign;
+use kappe::commands::ceiling::CeilingDesign;
 use kappe::output::{OutputError, OutputFile};
 
 /// Files as Python gets them: `(relative name, bytes)`.
@@ -60,7 +60,9 @@ pub fn ceiling_run_bay<'py>(
     options.robot = !no_robot;
     options.allow_fail = allow_fail;
     let bay = py
-        .detach(|| kappe::ceiling::run_bay(&ceiling, index, &options, &kappe::no_progress))
+        .detach(|| {
+            kappe::commands::ceiling::run_bay(&ceiling, index, &options, &kappe::no_progress)
+        })
         .map_err(|e| crate::design_error(&e))?;
     let files = bay.files(allow_fail).map_err(|e| output_error(&e))?;
     Ok((
@@ -82,10 +84,10 @@ pub fn ceiling_assemble(text: &str, bays: Vec<String>) -> PyResult<(String, Stri
         .map(|b| serde_json::from_str(b))
         .collect::<Result<Vec<serde_json::Value>, _>>()
         .map_err(|e| PyValueError::new_err(format!("bays: {e}")))?;
-    let summary = kappe::ceiling::ceiling_summary(&ceiling, rows);
+    let summary = kappe::commands::ceiling::ceiling_summary(&ceiling, rows);
     let json = serde_json::to_string_pretty(&summary)
         .map_err(|e| PyRuntimeError::new_err(format!("ceiling.json: {e}")))?;
-    let html = kappe::ceiling::index_html(&ceiling, &summary);
+    let html = kappe::commands::ceiling::index_html(&ceiling, &summary);
     Ok((json, html))
 }
 

@@ -64,7 +64,7 @@ fn default_design_toml() -> String {
 /// The commented example design file (`kappe init`).
 #[pyfunction]
 fn example_design_toml() -> &'static str {
-    kappe::spec::EXAMPLE_TOML
+    kappe::input::design::EXAMPLE_TOML
 }
 
 /// Parse and validate a design given as TOML text; returns its complete TOML (every field).
@@ -249,7 +249,8 @@ impl PyOutcome {
 
     /// The final state's network (JSON text, network.json).
     fn network_json(&self) -> PyResult<String> {
-        let v = kappe::export::network_json(&self.out.cap).map_err(|e| design_error(&e))?;
+        let v =
+            kappe::output::network::network_json(&self.out.cap).map_err(|e| design_error(&e))?;
         serde_json::to_string(&v).map_err(|e| json_err("network", e))
     }
 
@@ -411,7 +412,7 @@ fn run_design(
 #[pyfunction]
 #[pyo3(signature = (text, source="study.toml", directory="."))]
 fn study_parse(text: &str, source: &str, directory: &str) -> PyResult<String> {
-    let study = kappe::study::parse(text, source, std::path::Path::new(directory))
+    let study = kappe::commands::study::parse(text, source, std::path::Path::new(directory))
         .map_err(|e| DesignError::new_err((e.to_string(), "study", "", "")))?;
     let designs: Vec<serde_json::Value> = study
         .variations
@@ -421,7 +422,7 @@ fn study_parse(text: &str, source: &str, directory: &str) -> PyResult<String> {
                 "index": v.index,
                 "name": v.name,
                 "design_toml": v.design_toml(),
-                "parameters": kappe::study::parameter_values(v, &study.parameters),
+                "parameters": kappe::commands::study::parameter_values(v, &study.parameters),
                 "error": v.design.as_ref().err(),
             })
         })
@@ -440,8 +441,8 @@ fn study_parse(text: &str, source: &str, directory: &str) -> PyResult<String> {
 /// library's `Variation::files_before` and `DesignRun::files`, so `StudyResult.write` writes
 /// the same bytes).
 fn run_json(
-    v: &kappe::study::Variation,
-    run: &kappe::study::DesignRun,
+    v: &kappe::commands::study::Variation,
+    run: &kappe::commands::study::DesignRun,
 ) -> Result<serde_json::Value, String> {
     let mut files = v.files_before();
     files.extend(run.files(v).map_err(|e| e.to_string())?);
@@ -469,7 +470,7 @@ fn study_run_one(
     source: &str,
     directory: &str,
 ) -> PyResult<String> {
-    let study = kappe::study::parse(text, source, std::path::Path::new(directory))
+    let study = kappe::commands::study::parse(text, source, std::path::Path::new(directory))
         .map_err(|e| DesignError::new_err((e.to_string(), "study", "", "")))?;
     let Some(v) = study.variations.get(index) else {
         return Err(PyValueError::new_err(format!(
@@ -477,8 +478,8 @@ fn study_run_one(
             study.variations.len()
         )));
     };
-    let params = kappe::study::parameter_values(v, &study.parameters);
-    let run = py.detach(|| kappe::study::run_one(v, params, no_robot));
+    let params = kappe::commands::study::parameter_values(v, &study.parameters);
+    let run = py.detach(|| kappe::commands::study::run_one(v, params, no_robot));
     Ok(run_json(v, &run)
         .map_err(PyRuntimeError::new_err)?
         .to_string())
@@ -500,21 +501,27 @@ fn study_run_local(
     if jobs == Some(0) {
         return Err(PyValueError::new_err("jobs: give at least 1"));
     }
-    let study = kappe::study::parse(text, source, std::path::Path::new(directory))
+    let study = kappe::commands::study::parse(text, source, std::path::Path::new(directory))
         .map_err(|e| DesignError::new_err((e.to_string(), "study", "", "")))?;
     let selected = study.select(None);
     let runs = std::sync::Mutex::new(std::collections::BTreeMap::new());
     let rows = py
         .detach(|| {
-            kappe::study::run_designs(&selected, &study.parameters, no_robot, jobs, &|v, step| {
-                if let kappe::study::Step::Done(run) = step {
-                    let json = run_json(v, run)?;
-                    if let Ok(mut r) = runs.lock() {
-                        r.insert(v.index, json);
+            kappe::commands::study::run_designs(
+                &selected,
+                &study.parameters,
+                no_robot,
+                jobs,
+                &|v, step| {
+                    if let kappe::commands::study::Step::Done(run) = step {
+                        let json = run_json(v, run)?;
+                        if let Ok(mut r) = runs.lock() {
+                            r.insert(v.index, json);
+                        }
                     }
-                }
-                Ok(())
-            })
+                    Ok(())
+                },
+            )
         })
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start the worker threads: {e}")))?;
     let mut runs = runs
@@ -542,12 +549,12 @@ fn study_collect(
     source: &str,
     directory: &str,
 ) -> PyResult<(String, String, String)> {
-    let study = kappe::study::parse(text, source, std::path::Path::new(directory))
+    let study = kappe::commands::study::parse(text, source, std::path::Path::new(directory))
         .map_err(|e| DesignError::new_err((e.to_string(), "study", "", "")))?;
-    let mut rows: Vec<kappe::study::Record> =
+    let mut rows: Vec<kappe::commands::study::Record> =
         serde_json::from_str(records_json).map_err(|e| json_err("records", e))?;
     rows.sort_by_key(|r| r.index);
-    let result = kappe::study::collect(&study, None, no_robot, rows)
+    let result = kappe::commands::study::collect(&study, None, no_robot, rows)
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
     let html = result
         .html()
@@ -728,9 +735,9 @@ fn optimize_design(
     max_evaluations: Option<usize>,
     progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<(String, String, String, bool)> {
-    use kappe::design_loop;
+    use kappe::commands::optimize;
     let (mut file, embedded) =
-        design_loop::OptimizeFile::from_any_toml_str(text).map_err(|e| design_error(&e))?;
+        optimize::OptimizeFile::from_any_toml_str(text).map_err(|e| design_error(&e))?;
     if let Some(n) = max_evaluations {
         if !(1..=10_000).contains(&n) {
             return Err(PyValueError::new_err(format!(
@@ -739,8 +746,8 @@ fn optimize_design(
         }
         file.max_evaluations = n;
     }
-    let start = design_loop::start_design(&file, embedded, std::path::Path::new(directory))
-        .map_err(|e| {
+    let start =
+        optimize::start_design(&file, embedded, std::path::Path::new(directory)).map_err(|e| {
             let why = std::error::Error::source(&e).map_or(String::new(), |c| format!(": {c}"));
             DesignError::new_err((format!("{e}{why}"), "design", "", ""))
         })?;
@@ -748,7 +755,7 @@ fn optimize_design(
     // loop after the evaluation under way.
     let deliver = |cb: &Bound<'_, PyAny>, e: String| -> PyResult<()> { cb.call1((e,)).map(drop) };
     let result = run_with_progress(py, progress, deliver, |stop, tick| {
-        design_loop::optimize_until(&file, &start, &|e| {
+        optimize::optimize_until(&file, &start, &|e| {
             tick(serde_json::to_string(e).unwrap_or_default());
             if stop.load(Ordering::Relaxed) {
                 ControlFlow::Break(())
@@ -757,7 +764,7 @@ fn optimize_design(
             }
         })
     })?;
-    let doc = design_loop::document(&file, &result).map_err(|e| design_error(&e))?;
+    let doc = optimize::document(&file, &result).map_err(|e| design_error(&e))?;
     let json = serde_json::to_string_pretty(&doc).map_err(|e| json_err("optimize.json", e))?;
     Ok((
         result.design.to_toml_string(),

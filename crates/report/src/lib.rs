@@ -37,7 +37,7 @@
 //!   `overhang` also draw their limits in the plots (units `kPa`/`Pa`/`MPa`, `mm`/`m`).
 //! - `timeline` (time of each path point), `cell` (stations, tool, mobile base, beams, floor),
 //!   `modes` (mode 1 on the bead nodes), `worst_places`, `quantities` (more colour quantities,
-//!   e.g. layer age and stiffness; each also gets a plot): `kappe::report_input` fills them.
+//!   e.g. layer age and stiffness; each also gets a plot): `kappe::output::report_input` fills them.
 //!
 //! Size: three.js is 0.77 MB; the default design's page is 2.4 MB; 1008 states (ten times the
 //! default) 20.3 MB (`cargo run --release -p kappe-report --example size_table`).

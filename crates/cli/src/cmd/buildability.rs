@@ -1,6 +1,6 @@
 //! `kappe buildability SPEC.toml --out DIR`: print a standard test object (straight wall or
 //! cylinder) layer by layer and check every layer count with the green-state time model, the
-//! shell FE and the strength checks of the cap (`kappe::buildability`). Writes
+//! shell FE and the strength checks of the cap (`kappe::commands::buildability`). Writes
 //! `DIR/buildability.json` (failure layer, failure mode, per layer count BLF and utilisations)
 //! and `DIR/schedule.csv`. `kappe init --kind buildability` writes a commented example spec.
 
@@ -34,7 +34,7 @@ pub struct BuildabilityArgs {
 pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
     let text = std::fs::read_to_string(&args.spec)
         .with_context(|| format!("cannot read the buildability spec {}", args.spec.display()))?;
-    let resolved = kappe::buildability::BuildabilitySpec::from_toml_str(&text)
+    let resolved = kappe::commands::buildability::BuildabilitySpec::from_toml_str(&text)
         .with_context(|| format!("invalid buildability spec {}", args.spec.display()))?;
     // The output location is checked before any computing (nothing is written on bad input).
     let prepared = match &args.out {
@@ -56,13 +56,14 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
         b.set_message("buildability");
         b
     };
-    let result = kappe::buildability::run(&resolved, &|_| bar.inc(1))?;
+    let result = kappe::commands::buildability::run(&resolved, &|_| bar.inc(1))?;
     bar.finish_and_clear();
     let json =
-        serde_json::to_string_pretty(&kappe::buildability::document(&resolved, &result))? + "\n";
+        serde_json::to_string_pretty(&kappe::commands::buildability::document(&resolved, &result))?
+            + "\n";
     if let Some(prepared) = prepared {
         let dir = prepared.path();
-        let schedule = kappe::buildability::checked_schedule(&resolved, &result);
+        let schedule = kappe::commands::buildability::checked_schedule(&resolved, &result);
         write_file_atomic(&dir.join("buildability.json"), json.as_bytes())?;
         write_file_atomic(&dir.join("schedule.csv"), schedule.to_csv().as_bytes())?;
         if let Some(notice) = prepared.commit()? {
@@ -74,7 +75,7 @@ pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
     } else {
         print!(
             "{}",
-            kappe::buildability::text_report(&resolved, &result, args.out.as_deref())
+            kappe::commands::buildability::text_report(&resolved, &result, args.out.as_deref())
         );
     }
     Ok(ExitCode::SUCCESS)

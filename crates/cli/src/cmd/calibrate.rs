@@ -1,5 +1,5 @@
 //! `kappe calibrate PROTOTYPES.toml`: derive BLF_min (and the equivalent effective E) from
-//! printed prototypes that stood or failed (paper §3.3, `kappe::calibrate`).
+//! printed prototypes that stood or failed (paper §3.3, `kappe::commands::calibrate_blf`).
 //!
 //! File format:
 //! ```toml
@@ -19,7 +19,7 @@
 //! ```
 //!
 //! A file with a `[buildability]` table calibrates the green-state time model from buildability
-//! prints instead (`kappe::print_calibration`):
+//! prints instead (`kappe::commands::calibrate_print`):
 //! ```toml
 //! buildability = "cylinder.toml"   # a buildability spec (path relative to this file, or inline)
 //! [fit]
@@ -37,7 +37,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use kappe::calibrate::{PrototypeFile, calibrate};
+use kappe::commands::calibrate_blf::{PrototypeFile, calibrate};
 
 use crate::output::{check_user_file, write_user_file};
 
@@ -64,15 +64,15 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
     }
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("cannot read the prototype file {}", path.display()))?;
-    if kappe::calibrate::is_prints_file(&text) {
+    if kappe::commands::calibrate_blf::is_prints_file(&text) {
         return run_prints(&args, &text);
     }
     let file = PrototypeFile::from_toml_str(&text)
         .with_context(|| format!("invalid prototype file {}", path.display()))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    let resolved = kappe::calibrate::resolve_prototypes(&file, base)?;
+    let resolved = kappe::commands::calibrate_blf::resolve_prototypes(&file, base)?;
     let cal = calibrate(&resolved, &file.analysis).context("calibration failed")?;
-    let doc = kappe::calibrate::document(&file, &cal);
+    let doc = kappe::commands::calibrate_blf::document(&file, &cal);
     if let Some(out) = &args.out {
         write_user_file(out, &serde_json::to_vec_pretty(&doc)?, args.force)?;
     }
@@ -80,7 +80,7 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(ExitCode::SUCCESS);
     }
-    print!("{}", kappe::calibrate::text_report(&cal));
+    print!("{}", kappe::commands::calibrate_blf::text_report(&cal));
     Ok(if cal.separable {
         ExitCode::SUCCESS
     } else {
@@ -90,14 +90,16 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
 
 /// `kappe calibrate` of a file with `[buildability]`: fit the time model to buildability prints.
 fn run_prints(args: &CalibrateArgs, text: &str) -> Result<ExitCode> {
-    use kappe::print_calibration::{PrintCalibrationFile, calibrate_prints};
+    use kappe::commands::calibrate_print::{PrintCalibrationFile, calibrate_prints};
     let path = &args.prototypes;
     let file = PrintCalibrationFile::from_toml_str(text)
         .with_context(|| format!("invalid calibration file {}", path.display()))?;
-    let spec =
-        kappe::print_calibration::resolve_spec(&file, path.parent().unwrap_or(Path::new(".")))?;
+    let spec = kappe::commands::calibrate_print::resolve_spec(
+        &file,
+        path.parent().unwrap_or(Path::new(".")),
+    )?;
     let cal = calibrate_prints(&spec, &file.fit, &file.prints).context("calibration failed")?;
-    let doc = kappe::print_calibration::document(&file, &cal);
+    let doc = kappe::commands::calibrate_print::document(&file, &cal);
     if let Some(out) = &args.out {
         write_user_file(out, &serde_json::to_vec_pretty(&doc)?, args.force)?;
     }
@@ -105,6 +107,6 @@ fn run_prints(args: &CalibrateArgs, text: &str) -> Result<ExitCode> {
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(ExitCode::SUCCESS);
     }
-    print!("{}", kappe::print_calibration::text_report(&cal));
+    print!("{}", kappe::commands::calibrate_print::text_report(&cal));
     Ok(ExitCode::SUCCESS)
 }

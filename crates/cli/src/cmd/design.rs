@@ -49,7 +49,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read the design file {}", path.display()))?;
-            if kappe::ceiling::is_ceiling_toml(&text) {
+            if kappe::commands::ceiling::is_ceiling_toml(&text) {
                 return run_ceiling(&args, &text, path);
             }
             kappe::Design::from_toml_str(&text)
@@ -153,13 +153,13 @@ fn tick(bar: &ProgressBar, p: kappe::Progress) {
 }
 
 /// A ceiling file (`[ceiling]` + `[[bay]]`, issue 15): every bay designed, analysed and planned
-/// (`kappe::ceiling::run_ceiling`); writes `ceiling.json` (the room summary), `index.html` (the
+/// (`kappe::commands::ceiling::run_ceiling`); writes `ceiling.json` (the room summary), `index.html` (the
 /// room page) and per bay `bay_N/{summary.json, report.html, path.csv}` plus, when the bay passes
 /// (or `--allow-fail`), its robot programs (`bay_N/program_partNN.script`, `programs.json`,
 /// `trajectory.csv`, `plan.json`; the mirrored second half of a `both_walls` bay under
 /// `bay_N/mirror/`).
 fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<ExitCode> {
-    let ceiling = kappe::ceiling::CeilingDesign::from_toml_str(text)
+    let ceiling = kappe::commands::ceiling::CeilingDesign::from_toml_str(text)
         .with_context(|| format!("invalid ceiling file {}", path.display()))?;
     // The bays share the file's [analysis] and [robot]: the first bay's design carries them.
     let first = ceiling
@@ -186,7 +186,7 @@ fn run_ceiling(args: &DesignArgs, text: &str, path: &std::path::Path) -> Result<
         ));
         std::ops::ControlFlow::Continue(())
     };
-    let out = kappe::ceiling::run_ceiling(&ceiling, &options, &on_progress)?;
+    let out = kappe::commands::ceiling::run_ceiling(&ceiling, &options, &on_progress)?;
     spinner.finish_and_clear();
     let files = out.files(args.allow_fail)?;
     let table = || out.table(&args.out);

@@ -1,5 +1,5 @@
 //! `kappe init [PATH] [--kind K]`: write a commented example file of any input format
-//! (`kappe::templates`; formats documented in `docs/formats/`).
+//! (`kappe::commands::templates`; formats documented in `docs/formats/`).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -23,8 +23,11 @@ pub struct InitArgs {
 }
 
 pub fn init(args: InitArgs) -> Result<ExitCode> {
-    let Some(text) = kappe::templates::example(&args.kind) else {
-        let kinds: Vec<&str> = kappe::templates::KINDS.iter().map(|(k, _)| *k).collect();
+    let Some(text) = kappe::commands::templates::example(&args.kind) else {
+        let kinds: Vec<&str> = kappe::commands::templates::KINDS
+            .iter()
+            .map(|(k, _)| *k)
+            .collect();
         return Err(Usage(format!(
             "--kind {}: unknown; allowed: {}",
             args.kind,

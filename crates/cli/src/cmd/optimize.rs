@@ -1,4 +1,4 @@
-//! `kappe optimize FILE.toml`: the design loop (`kappe::design_loop`). FILE is either a design
+//! `kappe optimize FILE.toml`: the design loop (`kappe::commands::optimize`). FILE is either a design
 //! file with an `[optimize]` table, or an optimize file with `design = "kappe.toml"` (or an inline
 //! `[design]` table) next to `[free]`:
 //!
@@ -26,7 +26,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use kappe::design_loop::{self, OptimizeFile};
+use kappe::commands::optimize::{self, OptimizeFile};
 
 use crate::exit::{self, Usage};
 use crate::output::prepare_dir;
@@ -62,21 +62,21 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         file.max_evaluations = n;
     }
     let base = path.parent().unwrap_or(Path::new("."));
-    let start = design_loop::start_design(&file, embedded, base)?;
+    let start = optimize::start_design(&file, embedded, base)?;
     // Refusals and unwritable locations fail here, before the loop runs.
     let prepared = prepare_dir(&args.out, args.force, "optimize")?;
     let quiet = args.quiet;
     if !quiet {
-        println!("{}", design_loop::evaluation_header());
+        println!("{}", optimize::evaluation_header());
     }
-    let result = design_loop::optimize(&file, &start, &|e| {
+    let result = optimize::optimize(&file, &start, &|e| {
         if !quiet {
             println!("{}", e.line());
         }
     })
     .context("the design loop failed")?;
 
-    let doc = design_loop::document(&file, &result)?;
+    let doc = optimize::document(&file, &result)?;
     let dir = prepared.path();
     std::fs::write(dir.join("design.toml"), result.design.to_toml_string())?;
     std::fs::write(dir.join("optimize.json"), serde_json::to_vec_pretty(&doc)?)?;

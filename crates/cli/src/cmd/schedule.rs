@@ -1,5 +1,5 @@
 //! `kappe schedule DESIGN.toml`: the least total print time for which every state passes the
-//! green-state checks (`[material.time]`), by a wait after each layer (`kappe::wait_search`).
+//! green-state checks (`[material.time]`), by a wait after each layer (`kappe::commands::least_waits`).
 //! Writes `DIR/schedule.csv` and `DIR/schedule.json` and prints the `[schedule] waits` line that
 //! puts the waits into the design (so `kappe design` checks and plans the same schedule).
 
@@ -39,8 +39,9 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
         None => None,
     };
     let cap = kappe::design_cap(&design, &|_| {})?;
-    let plan = kappe::wait_search::least_waits(&cap, &design.analysis, args.wait_max, &|_| {})?;
-    let json = serde_json::to_string_pretty(&kappe::wait_search::document(
+    let plan =
+        kappe::commands::least_waits::least_waits(&cap, &design.analysis, args.wait_max, &|_| {})?;
+    let json = serde_json::to_string_pretty(&kappe::commands::least_waits::document(
         &design,
         args.wait_max,
         &plan,
@@ -56,7 +57,10 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
     if args.json {
         print!("{json}");
     } else {
-        print!("{}", kappe::wait_search::text_report(&plan, args.wait_max));
+        print!(
+            "{}",
+            kappe::commands::least_waits::text_report(&plan, args.wait_max)
+        );
     }
     Ok(if plan.infeasible.is_empty() {
         ExitCode::SUCCESS

@@ -1,6 +1,6 @@
 //! `kappe study STUDY.toml --out DIR` and `kappe study merge DIR... --out DIR`: design studies.
 //! The study engine (file format, expansion, per-design runs, merge, the CSV) is
-//! [`kappe::study`]; this module parses arguments, shows progress and writes the files: per
+//! [`kappe::commands::study`]; this module parses arguments, shows progress and writes the files: per
 //! design `DIR/designs/<name>/{design.toml, summary.json, report.html}`, and `DIR/study.csv`,
 //! `DIR/study.html`, `DIR/study.json`, the whole directory atomically.
 
@@ -10,7 +10,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use kappe::study::{Step, StudyResult, Variation};
+use kappe::commands::study::{Step, StudyResult, Variation};
 
 use crate::exit::Usage;
 use crate::output::{PreparedDir, prepare_dir};
@@ -111,8 +111,10 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         return Err(Usage("give a STUDY.toml and --out DIR".into()).into());
     };
     let shard = match args.shard.as_deref() {
-        Some("slurm") => Some(kappe::study::slurm_shard(|k| std::env::var(k).ok())?),
-        other => other.map(kappe::study::parse_shard).transpose()?,
+        Some("slurm") => Some(kappe::commands::study::slurm_shard(|k| {
+            std::env::var(k).ok()
+        })?),
+        other => other.map(kappe::commands::study::parse_shard).transpose()?,
     };
     let text = std::fs::read_to_string(&path)
         .with_context(|| format!("cannot read the study file {}", path.display()))?;
@@ -121,7 +123,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         |s| s.to_string_lossy().into_owned(),
     );
     let study_dir = path.parent().unwrap_or(Path::new("."));
-    let study = kappe::study::parse(&text, &source, study_dir)
+    let study = kappe::commands::study::parse(&text, &source, study_dir)
         .with_context(|| format!("invalid study file {}", path.display()))?;
 
     let selected: Vec<&Variation> = study.select(shard);
@@ -143,7 +145,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
     // Refusals and unwritable locations fail here, before any design runs.
     let prepared = prepare_dir(&out, args.force, "study")?;
     std::fs::create_dir_all(prepared.path().join("designs"))?;
-    let rows = kappe::study::run_designs(
+    let rows = kappe::commands::study::run_designs(
         &selected,
         &study.parameters,
         args.no_robot,
@@ -158,7 +160,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         },
     )
     .context("cannot start the worker threads")?;
-    let result = kappe::study::collect(&study, shard, args.no_robot, rows)?;
+    let result = kappe::commands::study::collect(&study, shard, args.no_robot, rows)?;
     prepared.write(&result.files()?)?;
     if let Some(notice) = prepared.commit()? {
         eprintln!("note: {notice}");
@@ -224,7 +226,7 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
         }
         parts.push((dir.display().to_string(), read_result(dir)?));
     }
-    let merged = kappe::study::merge(&parts, args.allow_incomplete)?;
+    let merged = kappe::commands::study::merge(&parts, args.allow_incomplete)?;
     let prepared = prepare_dir(&args.out, args.force, "study merge")?;
     {
         let dir = prepared.path();

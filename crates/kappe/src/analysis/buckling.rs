@@ -1,4 +1,4 @@
-//! The linear buckling run of one print state: its shell model ([`crate::shell`]) under
+//! The linear buckling run of one print state: its shell model ([`crate::analysis::shell`]) under
 //! self-weight, solved by `kappe_fe::buckling`; the lowest positive factor is the state's BLF.
 //! A shell model that is a mechanism is reported with the layers of its free motion.
 
@@ -6,12 +6,12 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use super::ageing::layer_ages;
-use super::options::AnalysisOptions;
-use crate::error::DesignError;
-use crate::pipeline::Cap;
-use crate::shell::{NoShell, ShellMaterial, StateShell, state_shell};
-use crate::states::State;
+use crate::analysis::shell::{NoShell, ShellMaterial, StateShell, state_shell};
+use crate::form::cap::Cap;
+use crate::form::states::State;
+use crate::input::ageing::layer_ages;
+use crate::input::analysis::AnalysisOptions;
+use crate::input::error::DesignError;
 
 /// What the buckling analysis of a state did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -36,7 +36,7 @@ pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> Shell
         cap,
         options,
         top,
-        crate::green::CapGreen::new(cap).ok().as_ref(),
+        crate::analysis::green::CapGreen::new(cap).ok().as_ref(),
     )
 }
 
@@ -46,7 +46,7 @@ pub fn state_material_with(
     cap: &Cap,
     options: &AnalysisOptions,
     top: usize,
-    green: Option<&crate::green::CapGreen>,
+    green: Option<&crate::analysis::green::CapGreen>,
 ) -> ShellMaterial {
     let d = &cap.design;
     let layer_modulus = match &options.ageing {
@@ -124,9 +124,9 @@ pub fn state_buckling_warm(
     options: &AnalysisOptions,
     guess: Option<&ModeGuess>,
 ) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
-    // A graded mesh (issue 15, `crate::window`) analyses the state reduced to its kept rows; the
+    // A graded mesh (issue 15, `crate::analysis::window`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
-    let analysed = crate::window::AnalysedState::new(state, options.grading.as_ref());
+    let analysed = crate::analysis::window::AnalysedState::new(state, options.grading.as_ref());
     let shell = match state_shell(analysed.state(), material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
@@ -146,7 +146,7 @@ pub fn state_buckling_warm(
     // First network index of every layer: the network stores each layer contiguously.
     let mut first: HashMap<i32, usize> = HashMap::new();
     for (i, n) in state.network.nodes.iter().enumerate() {
-        if n.role != crate::states::Role::ColumnEnd {
+        if n.role != crate::form::states::Role::ColumnEnd {
             first.entry(n.layer).or_insert(i);
         }
     }
@@ -237,7 +237,7 @@ fn shell_buckling_run(
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
         // modelling error and saves Lanczos steps over the default 1e-10. A graded mesh is
-        // itself an approximation (≤ 1 %, `crate::window`): there 1e-6 suffices, since a Ritz
+        // itself an approximation (≤ 1 %, `crate::analysis::window`): there 1e-6 suffices, since a Ritz
         // value with relative residual r lies within r (and, given the gap to the next mode,
         // within ~r²) of an eigenvalue of the symmetric operator.
         tolerance: if options.grading.is_some() {

@@ -11,13 +11,13 @@ use super::buckling::{
     BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_mode,
     state_buckling_warm, state_material_with,
 };
-use super::options::AnalysisOptions;
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
 };
-use crate::error::DesignError;
-use crate::pipeline::Cap;
-use crate::states::build_state;
+use crate::form::cap::Cap;
+use crate::form::states::build_state;
+use crate::input::analysis::AnalysisOptions;
+use crate::input::error::DesignError;
 
 /// Consecutive states per warm-started run of the graded analysis: each run's first state
 /// starts cold, so longer runs save more Lanczos steps; shorter ones balance the cores better.
@@ -243,12 +243,12 @@ pub(crate) fn analyze_scheduled(
         green: Option<GreenChecks>,
     }
     type GreenChecks = (
-        Option<crate::green::WorstElement>,
-        Option<crate::green::WorstElement>,
+        Option<crate::analysis::green::WorstElement>,
+        Option<crate::analysis::green::WorstElement>,
     );
     // Green state (issue 11): strength and bed-joint sliding with the layers' ages, only when
     // `[material.time]` gives a strength model (otherwise nothing changes).
-    let green = crate::green::CapGreen::with_schedule(cap, schedule)?;
+    let green = crate::analysis::green::CapGreen::with_schedule(cap, schedule)?;
     let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
     // Phase 1: every state's force pass and element stresses (cheap). Against an end wall the
     // final state's force pass gives every state's extremes (`extremes_by_depth`: linear, not

@@ -6,11 +6,11 @@
 //! - **Stresses.** Every element's normal stress σ = N / A (compression negative), with
 //!   A = lw·lh for arch segments (along a layer) and A = lw·l_trib for the bed joints between
 //!   layers (the column edges), from CEM's fixed-geometry force pass over the constructed
-//!   network ([`crate::forces`]). Checked against σ_min ≤ σ ≤ σ_max.
+//!   network ([`crate::form::forces`]). Checked against σ_min ≤ σ ≤ σ_max.
 //! - **Overhang.** |l_o| of every printed layer over the preceding one
 //!   ([`overhang::layer_overhangs`]) against l_o,max.
 //! - **Buckling.** The lowest positive linear buckling factor of the state's shell model
-//!   ([`crate::shell`], `kappe_fe`) under self-weight, against BLF_min. A state whose shell
+//!   ([`crate::analysis::shell`], `kappe_fe`) under self-weight, against BLF_min. A state whose shell
 //!   model is a mechanism is reported with the layer where the free motion sits.
 //!
 //! The report ([`ConstraintResult`]) gives for each constraint its limit, the worst value over all
@@ -28,19 +28,19 @@
 //! green material's modulus by layer age), [`buckling`] (the shell buckling run of one state)
 //! and [`check`] ([`analyze`]: every state against every constraint, and the report).
 
-pub mod ageing;
 pub mod buckling;
 pub mod check;
-pub mod options;
-pub mod overhang;
+pub mod green;
+pub mod shell;
 pub mod stress;
+pub mod window;
 
-pub use ageing::Ageing;
+pub use crate::form::overhang::layer_overhangs;
+pub use crate::input::ageing::Ageing;
+pub use crate::input::analysis::{AnalysisOptions, SelectionError, StateSelection};
 pub use buckling::{
     BucklingStatus, NetworkMode, StateBuckling, shell_buckling, shell_buckling_mode,
     state_buckling, state_buckling_mode, state_material,
 };
 pub use check::{Analysis, ConstraintResult, StateAnalysis, Timings, analyze};
-pub use options::{AnalysisOptions, SelectionError, StateSelection};
-pub use overhang::layer_overhangs;
 pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};

@@ -1,17 +1,17 @@
 //! Element normal stresses of a print state (method.md §3): σ = N / A, compression negative,
 //! with A = lw·lh for arch segments (along a layer) and A = lw·l_trib for the bed joints
 //! between layers (the column edges), l_trib the tributary length of the column node along its
-//! layer. The forces come from CEM's fixed-geometry force pass ([`crate::forces`]).
+//! layer. The forces come from CEM's fixed-geometry force pass ([`crate::form::forces`]).
 
 use std::collections::HashMap;
 
 use serde::Serialize;
 
-use crate::ends::EndKind;
-use crate::error::DesignError;
-use crate::forces::{Sections2D, state_forces};
-use crate::section::Sections;
-use crate::states::{Role, State};
+use crate::form::ends::EndKind;
+use crate::form::forces::{Sections2D, state_forces};
+use crate::form::section::Sections;
+use crate::form::states::{Role, State};
+use crate::input::error::DesignError;
 
 /// Relative tolerance on stress limits: a stress passes if it is within `1e-9·max|σ|` of its
 /// limit (the relative size of the force pass's residuals, method.md §9), so that σ_max = 0 is
@@ -41,7 +41,7 @@ pub enum ElementKind {
         /// Layer id.
         layer: i32,
     },
-    /// The bed joint of layer `layer` (0) on the end wall (`crate::ends`): A = lw·l_trib.
+    /// The bed joint of layer `layer` (0) on the end wall (`crate::form::ends`): A = lw·l_trib.
     WallJoint {
         /// Layer id.
         layer: i32,
@@ -116,7 +116,7 @@ pub fn element_stresses(
         let (Some(nu), Some(nv)) = (net.nodes.get(u), net.nodes.get(v)) else {
             continue;
         };
-        // A column end above the base plane lies on an end-wall face (`crate::ends`).
+        // A column end above the base plane lies on an end-wall face (`crate::form::ends`).
         let kind = if nv.role == Role::ColumnEnd && nv.xyz.z > 0.0 {
             ElementKind::WallJoint { layer: nu.layer }
         } else if nv.role == Role::ColumnEnd {
@@ -323,7 +323,7 @@ pub(crate) fn extremes_by_depth(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::states::build_state;
+    use crate::form::states::build_state;
 
     /// Every state's extremes from the final state's force pass equal those of the state's own
     /// force pass (end-wall caps of 0.3 and 0.6 m, every state). Tolerance 1e-12 of the state's

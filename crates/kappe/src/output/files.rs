@@ -72,7 +72,7 @@ impl Outcome {
     /// [`OutputError::Produce`] when a file cannot be produced (see [`plan_files`]).
     pub fn files(&self) -> Result<Vec<OutputFile>> {
         let cap = &self.cap;
-        let network = crate::export::network_json(cap)
+        let network = crate::output::network::network_json(cap)
             .map_err(|e| OutputError::Produce(format!("cannot write network.json: {e}")))?;
         let report = self
             .report_html()

@@ -1,0 +1,30 @@
+//! The commented example files `kappe init --kind K` writes, one per input format. Each is
+//! reproduced verbatim in its page under `docs/formats/` and run by the CLI tests, so the
+//! examples, the docs and the readers cannot drift apart.
+
+/// The kinds of example file, with the text `kappe init --kind` writes.
+pub const KINDS: [(&str, &str); 6] = [
+    ("design", crate::input::design::EXAMPLE_TOML),
+    ("study", STUDY_TOML),
+    ("prototypes", PROTOTYPES_TOML),
+    ("optimize", OPTIMIZE_TOML),
+    ("buildability", crate::commands::buildability::EXAMPLE_TOML),
+    ("ceiling", crate::commands::ceiling::EXAMPLE_TOML),
+];
+
+/// A design study (`kappe study`): a 2 × 2 grid of short caps.
+pub const STUDY_TOML: &str = include_str!("templates/study.toml");
+/// Printed prototypes for `kappe calibrate`.
+pub const PROTOTYPES_TOML: &str = include_str!("templates/prototypes.toml");
+/// The design loop (`kappe optimize`).
+pub const OPTIMIZE_TOML: &str = include_str!("templates/optimize.toml");
+
+/// The example text of `kind`, if it is one of [`KINDS`].
+///
+/// ```
+/// assert!(kappe::commands::templates::example("study").unwrap().contains("[grid]"));
+/// assert!(kappe::commands::templates::example("nonsense").is_none());
+/// ```
+pub fn example(kind: &str) -> Option<&'static str> {
+    KINDS.iter().find(|(k, _)| *k == kind).map(|(_, t)| *t)
+}

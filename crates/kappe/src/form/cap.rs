@@ -1,0 +1,179 @@
+//! The whole cap pipeline as one plain function: design → arch → sections → states → forces →
+//! path → mesh. States are independent and solved in parallel (rayon); their order is kept.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+
+use crate::analysis::layer_overhangs;
+use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer};
+use crate::form::beads::{TriMesh, bead_mesh};
+use crate::form::forces::{Sections2D, StateForces, state_forces};
+use crate::form::frame::LayerFrame;
+use crate::form::path::{PrintPath, print_path};
+use crate::form::section::{Sections, build_sections_with_end};
+use crate::form::states::{State, build_state};
+use crate::input::design::Design;
+use crate::input::error::DesignError;
+
+/// Summary of one print state.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct StateSummary {
+    /// State index (0 = first layer printed).
+    pub index: usize,
+    /// Print progress Pp in (0, 1].
+    pub progress: f64,
+    /// Layers printed so far.
+    pub layers_printed: usize,
+    /// Id of the top layer.
+    pub top_layer: i32,
+    /// Nodes in the state network.
+    pub nodes: usize,
+    /// Layer factor d of every printed layer, in print order (1 for centre layers).
+    #[serde(skip)]
+    pub factors: Vec<f64>,
+    /// Forces, stresses, residual and reactions.
+    #[serde(flatten)]
+    pub forces: StateForces,
+}
+
+/// A designed cap: every intermediate product of the pipeline.
+#[derive(Debug, Clone)]
+pub struct Cap {
+    /// The validated design.
+    pub design: Design,
+    /// The layer frame.
+    pub frame: LayerFrame,
+    /// Layer 0.
+    pub arch: Arch,
+    /// The catenary limit of layer 0 (closed form).
+    pub catenary: Catenary,
+    /// All layers in print order.
+    pub sections: Sections,
+    /// Overhang of every layer over the previous one, in print order, m.
+    pub overhangs: Vec<f64>,
+    /// One summary per state, in print order.
+    pub states: Vec<StateSummary>,
+    /// The final state (100 %) with its network.
+    pub final_state: State,
+    /// Its CEM topology.
+    pub final_topology: kappe_cem::Topology,
+    /// Its CEM force-pass result.
+    pub final_forces: kappe_cem::fixed_geometry::ForcePass,
+    /// The print path.
+    pub path: PrintPath,
+    /// The printed beads.
+    pub mesh: TriMesh,
+}
+
+impl Cap {
+    /// Cross-section areas for stresses.
+    pub fn areas(&self) -> Sections2D {
+        areas(&self.design, &self.arch)
+    }
+}
+
+fn areas(design: &Design, arch: &Arch) -> Sections2D {
+    let lw = design.print.layer_width;
+    Sections2D {
+        along_layer: lw * design.print.layer_height,
+        bed_joint: lw * arch.segment_length,
+    }
+}
+
+/// Form-find the layer, build the sections and states, and solve the forces of every state.
+/// `on_state(total)` is called once per solved state (for a progress bar), with the state count.
+pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<Cap, DesignError> {
+    design_cap_until(design, on_state, &AtomicBool::new(false))
+}
+
+/// [`design_cap`] that gives up with [`DesignError::Cancelled`] once `stop` is set (checked
+/// before every state).
+pub(crate) fn design_cap_until(
+    design: &Design,
+    on_state: &(dyn Fn(usize) + Sync),
+    stop: &AtomicBool,
+) -> Result<Cap, DesignError> {
+    design.validate()?;
+    let tilt = design.tilt();
+    let frame = LayerFrame::new(tilt);
+    let spec = ArchSpec {
+        span: design.cap.span,
+        rise: design.cap.rise,
+        tilt,
+        specific_weight: design.material.specific_weight,
+        layer_width: design.print.layer_width,
+        layer_height: design.print.layer_height,
+        path_sampling: design.print.path_sampling,
+    };
+    let arch = form_find_layer(&spec)?;
+    let catenary = Catenary::new(spec.span, spec.rise, tilt, spec.specific_weight);
+    let bead_weight_per_m =
+        design.material.specific_weight * design.print.layer_width * design.print.layer_height;
+    let sections = build_sections_with_end(
+        &arch,
+        &frame,
+        design.cap.length,
+        design.print.layer_height,
+        design.print.start_arch_fraction,
+        |chord| 0.5 * chord * bead_weight_per_m,
+        design.cap.end,
+    )?;
+    let overhangs = layer_overhangs(&sections, &frame);
+    let phi = design.print.start_arch_fraction;
+    let area = areas(design, &arch);
+    let total = sections.layers.len();
+    let solve = |top: usize| {
+        if stop.load(Ordering::Relaxed) {
+            return Err(DesignError::Cancelled);
+        }
+        let state = build_state(&sections, &frame, phi, top)?;
+        let (topology, pass, forces) = state_forces(&state, area)?;
+        on_state(total);
+        let summary = StateSummary {
+            index: state.index,
+            progress: state.progress,
+            layers_printed: state.layers_printed,
+            top_layer: state.top_layer,
+            nodes: state.network.nodes.len(),
+            factors: state.factors.clone(),
+            forces,
+        };
+        Ok::<_, DesignError>((state, topology, pass, summary))
+    };
+    // Every state but the last keeps only its summary; the final one keeps its network too.
+    let mut summaries: Vec<StateSummary> = (0..total - 1)
+        .into_par_iter()
+        .map(|top| solve(top).map(|(_, _, _, summary)| summary))
+        .collect::<Result<_, DesignError>>()?;
+    let (final_state, final_topology, final_forces, final_summary) = solve(total - 1)?;
+    summaries.push(final_summary);
+    let path = print_path(
+        &sections,
+        &frame,
+        design.print.layer_height,
+        design.print.layer_width,
+        design.material.specific_weight,
+        design.print.print_speed,
+    );
+    let mesh = bead_mesh(
+        &sections,
+        &frame,
+        design.print.layer_width,
+        design.print.layer_height,
+    );
+    Ok(Cap {
+        design: design.clone(),
+        frame,
+        arch,
+        catenary,
+        sections,
+        overhangs,
+        states: summaries,
+        final_state,
+        final_topology,
+        final_forces,
+        path,
+        mesh,
+    })
+}

@@ -1,0 +1,334 @@
+//! Print states (method.md §5–7): the network of every "layers printed so far" state, with its
+//! geometry constructed from the sections and one layer factor d per start layer solved top-down.
+//!
+//! For a layer with incoming trail force `r` (per unit node weight, the force the trail edge from
+//! the layer above exerts... carried down the column), the start-layer factor `d_m` solves
+//!
+//! ```text
+//! (r + e_z + d_m (tan(am) e_y − e_z)) × ê_m = 0,   ê_m = −unit(T_{m+1} − T_m),
+//! ```
+//!
+//! so the column force stays along the trail edge to the next layer; then
+//! `r ← r + e_z + d_m (tan(am) e_y − e_z)`. Centre layers have d = 1 (r grows by tan(am) e_y), the
+//! last start layer −K is free and takes d = φ; its column edges run along r to the base plane.
+//! Against an end wall there are no start layers; every column ends with the horizontal bed joint
+//! from layer 0 to the wall face ([`crate::form::ends`]).
+
+use crate::form::ends::EndKind;
+use crate::form::frame::{LayerFrame, V3};
+use crate::form::section::{NodeKind, Sections};
+use crate::input::error::DesignError;
+
+/// The role of a node in a state network.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// A layer node on a column (trail).
+    Column,
+    /// A layer foot on the base plane: a reaction node (support without trail edge).
+    Foot,
+    /// The end of a column: the support of that trail, on the base plane (start section) or on
+    /// the end-wall face (end wall, `crate::form::ends`).
+    ColumnEnd,
+}
+
+/// A node of a state network.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NetNode {
+    /// Position, m.
+    pub xyz: V3,
+    /// Gravity load, N.
+    pub load: V3,
+    /// Layer id (the column end takes the id of the layer above it).
+    pub layer: i32,
+    /// Column, foot or column end.
+    pub role: Role,
+}
+
+/// An arch segment of a layer: a deviation edge with a prescribed force.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DevEdge {
+    /// End nodes (indices into `nodes`).
+    pub u: usize,
+    /// End nodes (indices into `nodes`).
+    pub v: usize,
+    /// Signed force, N (compression < 0).
+    pub force: f64,
+    /// Layer id.
+    pub layer: i32,
+}
+
+/// The CEM network of one print state, with constructed geometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Network {
+    /// All nodes.
+    pub nodes: Vec<NetNode>,
+    /// Columns as trails, origin (top layer) → support (column end on the base plane).
+    pub trails: Vec<Vec<usize>>,
+    /// Arch segments.
+    pub deviation_edges: Vec<DevEdge>,
+}
+
+/// One print state: the first `layers_printed` layers in print order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// 0-based state index (= print index of the top layer).
+    pub index: usize,
+    /// Number of layers printed.
+    pub layers_printed: usize,
+    /// Id of the top (last printed) layer.
+    pub top_layer: i32,
+    /// Print progress Pp in (0, 1].
+    pub progress: f64,
+    /// Layer factor d of every printed layer, in print order (1 for centre layers).
+    pub factors: Vec<f64>,
+    /// Column force per unit node weight below each printed layer, in print order.
+    pub column_force_per_weight: Vec<V3>,
+    /// The network.
+    pub network: Network,
+}
+
+/// Build the state whose top layer has print index `top`.
+pub fn build_state(
+    sections: &Sections,
+    frame: &LayerFrame,
+    phi: f64,
+    top: usize,
+) -> Result<State, DesignError> {
+    let total = sections.layers.len();
+    let Some(top_layer) = sections.layers.get(top) else {
+        return Err(DesignError::State {
+            state: top,
+            message: format!("no such state (there are {total})"),
+        });
+    };
+    let k_start = sections.n_start;
+    let ez = V3::z();
+    let lean = frame.lean();
+    let b = lean - ez;
+
+    // Top-down: layer factors and column forces.
+    let mut factors = vec![0.0; top + 1];
+    let mut r_below = vec![V3::zeros(); top + 1];
+    let mut r = V3::zeros();
+    for q in (0..=top).rev() {
+        let id = sections.layers[q].id;
+        let a = r + ez;
+        let d = if id >= 0 {
+            1.0
+        } else {
+            let m = (-id) as usize;
+            if m == k_start {
+                phi
+            } else {
+                let e = -(sections.translations[m + 1] - sections.translations[m]).normalize();
+                // Planar problem in the y–z plane: the x-component of the cross product.
+                let ax = a.y * e.z - a.z * e.y;
+                let bx = b.y * e.z - b.z * e.y;
+                if bx.abs() < 1e-300 {
+                    return Err(DesignError::State {
+                        state: top,
+                        message: format!("layer {id}: the layer factor is undetermined"),
+                    });
+                }
+                -ax / bx
+            }
+        };
+        r = a + b * d;
+        if id < 0 {
+            let m = (-id) as usize;
+            let e = if m == k_start {
+                r.normalize()
+            } else {
+                -(sections.translations[m + 1] - sections.translations[m]).normalize()
+            };
+            if !(-1e-12..=1.0 + 1e-12).contains(&d) || r.dot(&e) <= 0.0 {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!(
+                        "layer {id}: factor d = {d:.4} outside [0, 1] or column force not compressive; \
+                         the start section cannot carry this state in compression"
+                    ),
+                });
+            }
+        }
+        factors[q] = d;
+        r_below[q] = r;
+    }
+
+    // Nodes, layer by layer, top-down.
+    let mut nodes = Vec::new();
+    let mut deviation_edges = Vec::new();
+    // Column ids are the indices of layer 0's nodes; node indices of each column, top-down.
+    let n_cols = sections
+        .print_index(0)
+        .and_then(|q| sections.layers.get(q))
+        .map_or(0, |l| l.nodes.len());
+    let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n_cols];
+    let mut last_layer_of_col: Vec<Option<usize>> = vec![None; n_cols];
+    for q in (0..=top).rev() {
+        let layer = &sections.layers[q];
+        let base = nodes.len();
+        for node in &layer.nodes {
+            let role = match node.kind {
+                NodeKind::Column(i) => {
+                    if let Some(col) = columns.get_mut(i) {
+                        col.push(nodes.len());
+                    }
+                    if let Some(slot) = last_layer_of_col.get_mut(i) {
+                        *slot = Some(q);
+                    }
+                    Role::Column
+                }
+                NodeKind::Foot => Role::Foot,
+            };
+            nodes.push(NetNode {
+                xyz: node.xyz,
+                load: -ez * node.weight,
+                layer: layer.id,
+                role,
+            });
+        }
+        for (s, f) in layer.segment_forces.iter().enumerate() {
+            deviation_edges.push(DevEdge {
+                u: base + s,
+                v: base + s + 1,
+                force: f * factors[q],
+                layer: layer.id,
+            });
+        }
+    }
+
+    // Column ends on the base plane.
+    let mut trails = Vec::new();
+    for (i, col) in columns.iter_mut().enumerate() {
+        let (Some(&last), Some(q)) = (col.last(), last_layer_of_col[i]) else {
+            continue;
+        };
+        let x = nodes[last].xyz;
+        let id = sections.layers[q].id;
+        if sections.end == EndKind::EndWall {
+            // The wall face is the plane of layer −1: the last bed joint is the horizontal step
+            // back from layer 0 (see `crate::form::ends`).
+            if id != 0 {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!(
+                        "column {i} ends in layer {id}, not on layer 0 at the end wall"
+                    ),
+                });
+            }
+            let end = x + sections
+                .translations
+                .get(1)
+                .copied()
+                .unwrap_or_else(V3::zeros);
+            col.push(nodes.len());
+            nodes.push(NetNode {
+                xyz: end,
+                load: V3::zeros(),
+                layer: id,
+                role: Role::ColumnEnd,
+            });
+            trails.push(col.clone());
+            continue;
+        }
+        let dir = if id >= 0 {
+            return Err(DesignError::State {
+                state: top,
+                message: format!("column {i} ends in centre layer {id}, not in the start section"),
+            });
+        } else {
+            let m = (-id) as usize;
+            if m == k_start {
+                -r_below[q]
+            } else {
+                sections.translations[m + 1] - sections.translations[m]
+            }
+        };
+        if dir.z >= 0.0 {
+            return Err(DesignError::State {
+                state: top,
+                message: format!("column {i} below layer {id} does not descend to the base plane"),
+            });
+        }
+        let mut end = x + dir * (x.z / -dir.z);
+        end.z = 0.0;
+        col.push(nodes.len());
+        nodes.push(NetNode {
+            xyz: end,
+            load: V3::zeros(),
+            layer: id,
+            role: Role::ColumnEnd,
+        });
+        trails.push(col.clone());
+    }
+
+    Ok(State {
+        index: top,
+        layers_printed: top + 1,
+        top_layer: top_layer.id,
+        progress: (top + 1) as f64 / total as f64,
+        factors,
+        column_force_per_weight: r_below,
+        network: Network {
+            nodes,
+            trails,
+            deviation_edges,
+        },
+    })
+}
+
+impl Network {
+    /// The CEM topology of this network: node ids are the node indices, columns are trails of
+    /// compression edges (their lengths are the constructed ones), arch segments are deviation
+    /// edges, feet are reaction nodes (supports without a trail edge) and column ends supports.
+    pub fn to_topology(&self, name: &str) -> kappe_cem::Topology {
+        use kappe_cem::topology::{DeviationEdge, Node, Topology, TrailEdge};
+        let nodes = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| Node {
+                id: i as u64,
+                xyz: n.xyz,
+                load: n.load,
+                support: matches!(n.role, Role::Foot | Role::ColumnEnd),
+                origin: None,
+            })
+            .collect();
+        let mut trail_edges = Vec::new();
+        for t in &self.trails {
+            for w in t.windows(2) {
+                let length = -(self.nodes[w[1]].xyz - self.nodes[w[0]].xyz).norm();
+                trail_edges.push(TrailEdge {
+                    u: w[0] as u64,
+                    v: w[1] as u64,
+                    length,
+                    plane: None,
+                });
+            }
+        }
+        let deviation_edges = self
+            .deviation_edges
+            .iter()
+            .map(|e| DeviationEdge {
+                u: e.u as u64,
+                v: e.v as u64,
+                force: e.force,
+            })
+            .collect();
+        Topology {
+            name: name.to_string(),
+            nodes,
+            trail_edges,
+            deviation_edges,
+            auxiliary_trails: None,
+            trail_shifts: Vec::new(),
+        }
+    }
+
+    /// Positions of all nodes, in node order.
+    pub fn positions(&self) -> Vec<V3> {
+        self.nodes.iter().map(|n| n.xyz).collect()
+    }
+}

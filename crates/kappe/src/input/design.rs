@@ -1,0 +1,583 @@
+//! The design specification: every parameter and constraint of `method.md` §2–3, with defaults,
+//! read from TOML and validated field by field.
+//!
+//! Units are SI (m, N, Pa, s); angles are degrees in the file and radians in code.
+
+use serde::{Deserialize, Serialize};
+
+use crate::input::error::DesignError;
+
+/// A complete cap-ceiling design: geometry, material, printing, constraints, robot.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Design {
+    /// A name for reports.
+    pub name: String,
+    /// Global geometry of the cap.
+    pub cap: CapSpec,
+    /// Material of the printed bead (green state).
+    pub material: MaterialSpec,
+    /// Bead and print-path settings.
+    pub print: PrintSpec,
+    /// Structural and fabrication limits.
+    pub constraints: ConstraintSpec,
+    /// Robot and tool settings (used by the motion planner).
+    pub robot: RobotSpec,
+    /// The print schedule: waits after layers, station-change time (green-state.md §3).
+    #[serde(skip_serializing_if = "crate::input::schedule::ScheduleSpec::is_empty")]
+    pub schedule: crate::input::schedule::ScheduleSpec,
+    /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
+    pub analysis: crate::analysis::AnalysisOptions,
+}
+
+/// Global geometry (method.md §2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CapSpec {
+    /// Cs: clear span between the springing lines, m.
+    pub span: f64,
+    /// Cr: height of the crown above the base plane, m.
+    pub rise: f64,
+    /// Cl: length of the centre section along y, measured on the base plane, m.
+    pub length: f64,
+    /// am: tilt of every layer plane from the vertical, degrees.
+    pub tilt_deg: f64,
+    /// What the first centre layer leans on: `"start_section"` (default, method.md §6) or
+    /// `"end_wall"` (an end wall takes the stack thrust; `kappe::form::ends`).
+    #[serde(skip_serializing_if = "EndKind::is_default")]
+    pub end: EndKind,
+}
+
+/// Material (method.md §2–3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MaterialSpec {
+    /// γ: specific weight of the green material, N/m³.
+    pub specific_weight: f64,
+    /// E: Young's modulus used for the buckling analysis, Pa.
+    pub youngs_modulus: f64,
+    /// ν: Poisson's ratio.
+    pub poisson_ratio: f64,
+    /// `[material.time]`: E and strength growing with the age of a layer (None: constant E
+    /// and the σ limits of `[constraints]`, as before).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<crate::input::material::TimeModelSpec>,
+}
+
+/// Bead and path (method.md §2, §7).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PrintSpec {
+    /// lh: spacing of consecutive layer planes along their normal, m.
+    pub layer_height: f64,
+    /// lw: bead width = shell thickness, m.
+    pub layer_width: f64,
+    /// d_n: nozzle diameter, m.
+    pub nozzle_diameter: f64,
+    /// Δs: target node spacing along a layer, m.
+    pub path_sampling: f64,
+    /// φ: share of the centre arch force that start layers keep in the final state, [0, 1).
+    pub start_arch_fraction: f64,
+    /// Nozzle speed along the path while printing, m/s.
+    pub print_speed: f64,
+}
+
+/// Constraints (method.md §3). Stresses are negative in compression.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ConstraintSpec {
+    /// σ_min: most negative allowed normal stress (compressive strength), Pa.
+    pub sigma_min: f64,
+    /// σ_max: largest allowed normal stress (tensile strength), Pa.
+    pub sigma_max: f64,
+    /// BLF_min: calibrated lower bound of the linear buckling load factor.
+    pub blf_min: f64,
+    /// l_o,max: largest allowed layer overhang, m. Default lw/2 (method.md §3).
+    pub overhang_max: Option<f64>,
+}
+
+/// Robot and tool settings for the motion planner (method.md §8, robot.md).
+///
+/// `setup` and `plan` are the planner's own settings (`kappe_robot::RobotSetup` and
+/// `kappe_robot::PlanOptions`, documented there). The print speed, bead radius and bead offset
+/// of `plan` are always taken from `[print]` (speed, lw/2, lh/2), and the two support beams of
+/// `beams` are added to the obstacles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RobotSpec {
+    /// Plan the robot motion as part of `kappe design`.
+    pub enabled: bool,
+    /// The support beams under the springing lines.
+    pub beams: BeamSpec,
+    /// Robot cell: base placement, tool, mobile base, floor, extra obstacles.
+    pub setup: kappe_robot::setup::RobotSetup,
+    /// Planner settings.
+    pub plan: kappe_robot::setup::PlanOptions,
+    /// The base-pose tolerance check of the plan (issue 15): `[robot.tolerance]`.
+    #[serde(skip_serializing_if = "ToleranceSpec::is_default")]
+    pub tolerance: ToleranceSpec,
+}
+
+/// `[robot.tolerance]`: the base-pose errors a relocated mobile base must tolerate
+/// (`kappe_robot::tolerance::check_base_tolerance`, run by `kappe design` on every plan and
+/// reported in `summary.json` under `robot.base_tolerance`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ToleranceSpec {
+    /// Run the check at all.
+    pub check: bool,
+    /// Largest position error of the base in x and y, m.
+    pub position: f64,
+    /// Largest yaw error of the base, degrees.
+    pub yaw_deg: f64,
+    /// Check every n-th waypoint of a layer (and always its first and last).
+    pub stride: usize,
+    /// A plan that does not tolerate the errors fails the design. Off by default until the
+    /// planner keeps the margins the check needs (the default design's plan fails it at
+    /// ±10 mm, ±1°: a self-distance of 3.5 mm at station 0, layer 66).
+    pub verdict: bool,
+}
+
+impl Default for ToleranceSpec {
+    fn default() -> Self {
+        let t = kappe_robot::tolerance::BaseTolerance::default();
+        ToleranceSpec {
+            check: true,
+            position: t.position,
+            yaw_deg: t.yaw_deg,
+            stride: t.stride,
+            verdict: false,
+        }
+    }
+}
+
+impl ToleranceSpec {
+    /// Whether this is the default (kept out of resolved design files).
+    pub fn is_default(&self) -> bool {
+        *self == ToleranceSpec::default()
+    }
+
+    /// The robot crate's tolerance.
+    pub fn base_tolerance(&self) -> kappe_robot::tolerance::BaseTolerance {
+        kappe_robot::tolerance::BaseTolerance {
+            position: self.position,
+            yaw_deg: self.yaw_deg,
+            stride: self.stride,
+        }
+    }
+}
+
+/// Two beams along y whose tops are the base plane and whose inner faces are the springing lines.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BeamSpec {
+    /// Beam width across x, m.
+    pub width: f64,
+    /// Beam height below the base plane, m.
+    pub height: f64,
+    /// How far the beams run beyond the printed cap at both ends, m.
+    pub overrun: f64,
+}
+
+impl Default for BeamSpec {
+    fn default() -> Self {
+        BeamSpec {
+            width: 0.12,
+            height: 0.24,
+            overrun: 0.05,
+        }
+    }
+}
+
+impl Default for RobotSpec {
+    fn default() -> Self {
+        RobotSpec {
+            enabled: true,
+            beams: BeamSpec::default(),
+            setup: kappe_robot::setup::RobotSetup::default(),
+            plan: kappe_robot::setup::PlanOptions::default(),
+            tolerance: ToleranceSpec::default(),
+        }
+    }
+}
+
+impl Default for Design {
+    fn default() -> Self {
+        Design {
+            name: "default".into(),
+            cap: CapSpec::default(),
+            material: MaterialSpec::default(),
+            print: PrintSpec::default(),
+            constraints: ConstraintSpec::default(),
+            robot: RobotSpec::default(),
+            schedule: crate::input::schedule::ScheduleSpec::default(),
+            analysis: crate::analysis::AnalysisOptions::default(),
+        }
+    }
+}
+
+impl Default for CapSpec {
+    fn default() -> Self {
+        CapSpec {
+            span: 0.8,
+            rise: 0.2,
+            length: 0.6,
+            tilt_deg: 25.0,
+            end: EndKind::StartSection,
+        }
+    }
+}
+
+impl Default for MaterialSpec {
+    fn default() -> Self {
+        MaterialSpec {
+            specific_weight: 23044.0,
+            youngs_modulus: 10.0e6,
+            poisson_ratio: 0.35,
+            time: None,
+        }
+    }
+}
+
+impl Default for PrintSpec {
+    fn default() -> Self {
+        PrintSpec {
+            layer_height: 0.008,
+            layer_width: 0.020,
+            nozzle_diameter: 0.015,
+            path_sampling: 0.02,
+            start_arch_fraction: 0.0,
+            print_speed: 0.05,
+        }
+    }
+}
+
+impl Default for ConstraintSpec {
+    fn default() -> Self {
+        ConstraintSpec {
+            sigma_min: -20.0e3,
+            sigma_max: 0.0,
+            blf_min: 1.0,
+            overhang_max: None,
+        }
+    }
+}
+
+/// The embedded default design file, with comments (what `kappe init` writes).
+pub const EXAMPLE_TOML: &str = include_str!("default_design.toml");
+
+impl Design {
+    /// Parse a design from TOML; every missing field takes its default. Unknown fields are errors.
+    ///
+    /// ```
+    /// let d = kappe::Design::from_toml_str("[cap]\nspan = 1.0\n").unwrap();
+    /// assert_eq!(d.cap.span, 1.0);
+    /// assert_eq!(d.cap.rise, 0.2);
+    /// ```
+    pub fn from_toml_str(text: &str) -> Result<Design, DesignError> {
+        let design: Design = parse_toml(text)?;
+        design.validate()?;
+        Ok(design)
+    }
+
+    /// Serialize to TOML (the resolved design, every field explicit).
+    pub fn to_toml_string(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Layer tilt am in radians.
+    pub fn tilt(&self) -> f64 {
+        self.cap.tilt_deg.to_radians()
+    }
+
+    /// The green-state time model: `[material.time]`, or the older `[analysis.ageing]` (linear
+    /// E only) read as the same model; the constant model with `[material] youngs_modulus`
+    /// when neither is given. Both at once is an error.
+    pub fn time_model(&self) -> Result<crate::input::material::TimeModel, DesignError> {
+        use crate::input::material::{Property, TimeLaw, TimeModel};
+        match (&self.material.time, &self.analysis.ageing) {
+            (Some(_), Some(_)) => Err(DesignError::Invalid {
+                field: "analysis.ageing",
+                value: "given together with [material.time]".into(),
+                allowed: "allowed: one time model; [analysis.ageing] is the older form of \
+                          [material.time] (model = \"linear\", youngs_modulus, \
+                          youngs_modulus_rate, youngs_modulus_max): move it there"
+                    .into(),
+            }),
+            (Some(t), None) => t.resolve(self.material.youngs_modulus),
+            (None, Some(a)) => Ok(TimeModel {
+                law: TimeLaw::Linear,
+                time_constant: f64::INFINITY,
+                youngs_modulus: Property {
+                    initial: a.initial_modulus,
+                    rate: a.rate,
+                    max: a.max_modulus,
+                },
+                strength: None,
+            }),
+            (None, None) => Ok(TimeModel::constant(self.material.youngs_modulus)),
+        }
+    }
+
+    /// l_o,max, defaulting to lw/2 (method.md §3).
+    pub fn overhang_max(&self) -> f64 {
+        self.constraints
+            .overhang_max
+            .unwrap_or(0.5 * self.print.layer_width)
+    }
+
+    /// Check every field against its allowed range (method.md §2–3).
+    pub fn validate(&self) -> Result<(), DesignError> {
+        fn check(
+            field: &'static str,
+            value: f64,
+            ok: bool,
+            allowed: impl Into<String>,
+        ) -> Result<(), DesignError> {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(DesignError::Invalid {
+                    field,
+                    value: format!("{value}"),
+                    allowed: allowed.into(),
+                })
+            }
+        }
+        let c = &self.cap;
+        let p = &self.print;
+        let m = &self.material;
+        let k = &self.constraints;
+        check(
+            "cap.span",
+            c.span,
+            c.span > 0.05 && c.span <= 20.0,
+            "allowed: 0.05 m < span ≤ 20 m",
+        )?;
+        check("cap.rise", c.rise, c.rise > 0.0, "allowed: rise > 0 m")?;
+        let ratio = c.rise / c.span;
+        check(
+            "cap.rise",
+            c.rise,
+            (0.05..=1.0).contains(&ratio),
+            format!(
+                "rise/span = {ratio:.3}; allowed: 0.05 ≤ rise/span ≤ 1 for a compression arch of this method \
+                 (flatter arches have unbounded thrust, steeper ones are not caps)"
+            ),
+        )?;
+        check(
+            "cap.length",
+            c.length,
+            c.length > 0.0 && c.length <= 50.0,
+            "allowed: 0 < length ≤ 50 m",
+        )?;
+        check(
+            "cap.tilt_deg",
+            c.tilt_deg,
+            c.tilt_deg > 0.0 && c.tilt_deg <= 60.0,
+            "allowed: 0° < tilt ≤ 60° (layer plane from the vertical)",
+        )?;
+        check(
+            "material.specific_weight",
+            m.specific_weight,
+            m.specific_weight > 0.0,
+            "allowed: specific weight > 0 N/m³",
+        )?;
+        check(
+            "material.youngs_modulus",
+            m.youngs_modulus,
+            m.youngs_modulus > 0.0,
+            "allowed: E > 0 Pa",
+        )?;
+        check(
+            "material.poisson_ratio",
+            m.poisson_ratio,
+            (0.0..0.5).contains(&m.poisson_ratio),
+            "allowed: 0 ≤ ν < 0.5",
+        )?;
+        check(
+            "print.nozzle_diameter",
+            p.nozzle_diameter,
+            p.nozzle_diameter > 0.0,
+            "allowed: > 0 m",
+        )?;
+        let dn = p.nozzle_diameter;
+        check(
+            "print.layer_height",
+            p.layer_height,
+            p.layer_height >= 0.4 * dn - 1e-12 && p.layer_height <= dn + 1e-12,
+            format!(
+                "allowed: 0.4·d_n ≤ layer height ≤ d_n, i.e. [{:.4}, {:.4}] m for this nozzle",
+                0.4 * dn,
+                dn
+            ),
+        )?;
+        check(
+            "print.layer_width",
+            p.layer_width,
+            p.layer_width >= dn - 1e-12 && p.layer_width <= 2.0 * dn + 1e-12,
+            format!(
+                "allowed: d_n ≤ layer width ≤ 2·d_n, i.e. [{:.4}, {:.4}] m for this nozzle",
+                dn,
+                2.0 * dn
+            ),
+        )?;
+        check(
+            "print.path_sampling",
+            p.path_sampling,
+            p.path_sampling > 0.0 && p.path_sampling <= c.span / 8.0,
+            format!(
+                "allowed: 0 < Δs ≤ span/8 = {:.4} m (at least 8 segments per arch)",
+                c.span / 8.0
+            ),
+        )?;
+        check(
+            "print.start_arch_fraction",
+            p.start_arch_fraction,
+            (0.0..1.0).contains(&p.start_arch_fraction),
+            "allowed: 0 ≤ φ < 1",
+        )?;
+        check(
+            "print.print_speed",
+            p.print_speed,
+            p.print_speed > 0.0 && p.print_speed <= 1.0,
+            "allowed: 0 < speed ≤ 1 m/s",
+        )?;
+        let n_layers = c.length * self.tilt().cos() / p.layer_height;
+        check(
+            "cap.length",
+            c.length,
+            (1.0..=5000.0).contains(&n_layers),
+            format!(
+                "gives {n_layers:.1} centre layers; allowed 1 to 5000 (length·cos(tilt)/layer height)"
+            ),
+        )?;
+        check(
+            "constraints.sigma_min",
+            k.sigma_min,
+            k.sigma_min < 0.0,
+            "allowed: σ_min < 0 Pa (compression is negative)",
+        )?;
+        check(
+            "constraints.sigma_max",
+            k.sigma_max,
+            k.sigma_max >= 0.0,
+            "allowed: σ_max ≥ 0 Pa",
+        )?;
+        check(
+            "constraints.blf_min",
+            k.blf_min,
+            k.blf_min > 0.0,
+            "allowed: BLF_min > 0",
+        )?;
+        if let Some(lo) = k.overhang_max {
+            check(
+                "constraints.overhang_max",
+                lo,
+                lo > 0.0,
+                "allowed: l_o,max > 0 m",
+            )?;
+        }
+        self.analysis.validate()?;
+        self.time_model()?;
+        self.schedule.waits(self.schedule.waits.len().max(1))?;
+        self.schedule.relocation_time()?;
+        let bm = &self.robot.beams;
+        check(
+            "robot.beams.width",
+            bm.width,
+            bm.width > 0.0,
+            "allowed: width > 0 m",
+        )?;
+        check(
+            "robot.beams.height",
+            bm.height,
+            bm.height > 0.0,
+            "allowed: height > 0 m",
+        )?;
+        check(
+            "robot.beams.overrun",
+            bm.overrun,
+            bm.overrun >= 0.0,
+            "allowed: overrun ≥ 0 m",
+        )?;
+        Ok(())
+    }
+}
+
+/// Deserialize TOML text into `T`, reporting the dotted path of a bad entry and, for an unknown
+/// field, the closest allowed name. Every TOML file Kappe reads goes through here.
+///
+/// A file that sets nothing (empty, or only comments) is an error rather than silently meaning
+/// "all defaults": a user who runs an empty file almost certainly meant another file.
+pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, DesignError> {
+    if toml::from_str::<toml::Table>(text).is_ok_and(|t| t.is_empty()) {
+        return Err(DesignError::Parse {
+            path: String::new(),
+            message: "the file is empty (it sets no table and no field); `kappe init` writes a \
+                      commented example, and `kappe design` without a file runs the default design"
+                .into(),
+        });
+    }
+    let de = toml::Deserializer::parse(text).map_err(|e| DesignError::Parse {
+        path: String::new(),
+        message: e.to_string().trim().to_string(),
+    })?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let message = e.into_inner().message().trim().to_string();
+        let message = match did_you_mean(&message) {
+            Some(hint) => format!("{message} (did you mean `{hint}`?)"),
+            None => message,
+        };
+        DesignError::Parse { path, message }
+    })
+}
+
+/// For serde's "unknown field `x`, expected one of `a`, `b`, …", the expected name closest to `x`
+/// by edit distance (at most 3 edits), so a typo gets a concrete suggestion.
+fn did_you_mean(message: &str) -> Option<String> {
+    let rest = message.strip_prefix("unknown field `")?;
+    let (typo, rest) = rest.split_once('`')?;
+    let candidates: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(typo, c), c))
+        .filter(|(d, _)| *d <= 3)
+        .min()
+        .map(|(_, c)| c.to_string())
+}
+
+/// Levenshtein distance between two short strings.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// What the first centre layer of a cap leans on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EndKind {
+    /// Printed start layers along the final-state thrust line to the base plane (method.md §6).
+    #[default]
+    StartSection,
+    /// An end wall (or abutment) whose inclined face carries the stack thrust (module docs).
+    EndWall,
+}
+
+impl EndKind {
+    /// Whether this is the default end (used to keep the resolved design files unchanged).
+    pub fn is_default(&self) -> bool {
+        *self == EndKind::default()
+    }
+}

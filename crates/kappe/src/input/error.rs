@@ -1,0 +1,43 @@
+//! Typed errors of the cap pipeline.
+
+use thiserror::Error;
+
+/// Everything that can go wrong between a design file and a finished cap.
+#[derive(Debug, Error)]
+pub enum DesignError {
+    /// The design file is not valid TOML or does not match the schema (unknown field, wrong type).
+    #[error("design file: {path}: {message}")]
+    Parse {
+        /// Dotted path of the offending entry (empty for a syntax error).
+        path: String,
+        /// What the parser said.
+        message: String,
+    },
+    /// A parameter or constraint is outside its allowed range.
+    #[error("design field `{field}` = {value}: {allowed}")]
+    Invalid {
+        /// Dotted field name, e.g. `cap.tilt_deg`.
+        field: &'static str,
+        /// The value given.
+        value: String,
+        /// What is allowed, in words.
+        allowed: String,
+    },
+    /// The layer arch could not be form-found for these parameters.
+    #[error("layer form-finding failed: {0}")]
+    FormFinding(String),
+    /// A print state violates an equilibrium invariant of the method (method.md §9).
+    #[error("print state {state}: {message}")]
+    State {
+        /// State index (0 = first layer printed).
+        state: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// The caller's progress callback asked the run to stop (e.g. Ctrl-C in Python).
+    #[error("cancelled")]
+    Cancelled,
+    /// The CEM engine rejected a network we built (a bug in Kappe if it happens).
+    #[error("CEM: {0}")]
+    Cem(#[from] kappe_cem::CemError),
+}
