@@ -83,7 +83,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             design.print.start_arch_fraction,
             top,
         )?;
-        let shell = state_shell(&state, &state_material(&cap, &options, top), 1)
+        let shell = state_shell(&state, &state_material(&cap, &options, top).unwrap(), 1)
             .map_err(|e| format!("{e:?}"))?;
         let mut l = [0.0; 2];
         for (k, el) in [ElementKind::CstDkt, ElementKind::AndesDkmt]

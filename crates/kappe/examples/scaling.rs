@@ -105,7 +105,7 @@ fn bay(span: f64, length: f64) -> Result<(), Box<dyn std::error::Error>> {
         analysis.map_or(0.0, |a| a.timings.total),
         peak_mb().unwrap_or(f64::NAN),
         measure::load_average(),
-        if b.outcome.ok { "pass" } else { "fail" }
+        if b.outcome.verdict.ok { "pass" } else { "fail" }
     );
     if let Some(a) = analysis {
         for c in a.constraints.iter().filter(|c| !c.pass) {

@@ -40,7 +40,7 @@ fn ceiling(file: Option<&String>) -> Result<(), Box<dyn std::error::Error>> {
             bay.design.cap.span,
             bay.outcome.cap.states.len(),
             total - fe,
-            bay.outcome.ok
+            bay.outcome.verdict.ok
         );
         bays.push(bay);
     }

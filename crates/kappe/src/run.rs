@@ -15,13 +15,13 @@ use crate::analysis::{Analysis, AnalysisOptions};
 use crate::form::cap::Cap;
 use crate::input::design::Design;
 use crate::input::error::DesignError;
-use crate::output::report_input::{ReportExtras, add_robot, extras_from_analysis, report_input};
+use crate::verdict::{RobotResults, Verdict};
 
 /// What [`run`] does after form-finding.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Options {
     /// The analysis of every state (stresses, overhang, shell buckling); `None`: no analysis,
-    /// the verdict is then the preliminary one of [`crate::verdict::design_ok`].
+    /// the verdict then takes the preliminary checks ([`crate::verdict::preliminary_constraints`]).
     pub analysis: Option<AnalysisOptions>,
     /// Plan the robot, for designs whose `robot.enabled` is set.
     pub robot: bool,
@@ -121,19 +121,22 @@ fn check(stop: &AtomicBool) -> Result<(), DesignError> {
 pub struct Outcome {
     /// The designed cap: every state, the layers, the print path, the mesh.
     pub cap: Cap,
-    /// Stresses, overhang and buckling of every state, and the constraint report; `None` when
-    /// not asked for.
-    pub analysis: Option<Analysis>,
     /// The robot plan, or why there is none; `None` when planning was not asked for (or the
     /// design disables the robot).
     pub robot: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
     /// The base-pose tolerance check of the plan (`[robot.tolerance]`, issue 15); `None`
     /// without a plan or with `check = false`.
     pub base_tolerance: Option<kappe_robot::tolerance::ToleranceReport>,
-    /// The analysis and robot results in report form.
-    pub extras: ReportExtras,
-    /// The verdict of [`crate::verdict::design_ok`].
-    pub ok: bool,
+    /// The one schedule of the run (issue 11): every layer's start, end, wait and station
+    /// change on the robot plan's clock when there is a plan, else from path length / print
+    /// speed and the `[schedule]` waits. The analysis ages the layers on it; `schedule.csv`
+    /// and the `schedule` block of `summary.json` are it.
+    pub schedule: crate::schedule::Schedule,
+    /// Stresses, overhang and buckling of every state, and the constraint report; `None` when
+    /// not asked for.
+    pub analysis: Option<Analysis>,
+    /// Pass or fail, and why ([`crate::verdict::verdict`]).
+    pub verdict: Verdict,
     /// [`Options::allow_fail`] of the run.
     pub allow_fail: bool,
 }
@@ -188,26 +191,19 @@ fn evaluate_until(
         None
     };
     check(stop)?;
-    let schedule = plan_schedule(&cap, robot.as_ref())?;
+    let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
     let analysis = match &options.analysis {
         Some(o) => Some(crate::analysis::check::analyze_scheduled(
             &cap,
             o,
-            schedule.as_ref(),
+            Some(&schedule),
             &|total| fe.tick(total),
             stop,
         )?),
         None => None,
     };
     check(stop)?;
-    let mut extras = analysis
-        .as_ref()
-        .map(extras_from_analysis)
-        .unwrap_or_default();
-    if let Some(plan) = &robot {
-        add_robot(&mut extras, plan);
-    }
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
     let tol = &cap.design.robot.tolerance;
@@ -218,101 +214,26 @@ fn evaluate_until(
         )),
         _ => None,
     };
-    if tol.verdict
-        && extras.robot_error.is_none()
-        && let Some(r) = base_tolerance.as_ref().filter(|r| !r.ok())
-    {
-        extras.robot_error = Some(format!(
-            "the plan does not tolerate base-pose errors of ±{} m, ±{}°: {}",
-            tol.position,
-            tol.yaw_deg,
-            r.problems.first().cloned().unwrap_or_default()
-        ));
-    }
-    extras.schedule = report_schedule(&cap, analysis.as_ref(), schedule);
-    let ok = crate::verdict::design_ok(&cap, &extras);
+    let verdict = crate::verdict::verdict(
+        &cap,
+        analysis.as_ref(),
+        RobotResults {
+            plan: robot.as_ref(),
+            tolerance: base_tolerance.as_ref(),
+        },
+    );
     Ok(Outcome {
         cap,
-        analysis,
         robot,
         base_tolerance,
-        extras,
-        ok,
+        schedule,
+        analysis,
+        verdict,
         allow_fail: options.allow_fail,
     })
 }
 
 impl Outcome {
-    /// `summary.json`: the cap's summary with the analysis merged in, the robot block
-    /// (stations with `world_from_base`, `flange_from_tcp`, motion, time, clearance; or why it
-    /// failed) and the verdict `ok`.
-    pub fn summary(&self) -> serde_json::Value {
-        let cap = &self.cap;
-        let mut summary = crate::output::network::summary_json(cap);
-        if let Some(analysis) = &self.analysis {
-            crate::output::network::add_analysis(&mut summary, analysis);
-        }
-        let robot = match &self.robot {
-            None => serde_json::json!({"planned": false, "reason": "disabled"}),
-            Some(Ok(plan)) => {
-                let mut v = plan_summary(plan);
-                if let (Some(obj), Some(t)) = (v.as_object_mut(), &self.base_tolerance) {
-                    obj.insert(
-                        "base_tolerance".into(),
-                        serde_json::json!({
-                            "ok": t.ok(),
-                            "position_m": t.tolerance.position,
-                            "yaw_deg": t.tolerance.yaw_deg,
-                            "stride": t.tolerance.stride,
-                            "poses_per_station": t.poses_per_station,
-                            "waypoints_checked": t.waypoints_checked,
-                            "min_clearance_m": t.min_clearance,
-                            "min_body_distance_m": t.min_body_distance,
-                            "problems": t.problems,
-                            "in_verdict": self.cap.design.robot.tolerance.verdict,
-                        }),
-                    );
-                }
-                v
-            }
-            Some(Err(e)) => {
-                serde_json::json!({"planned": false, "ok": false, "failure": e.to_string()})
-            }
-        };
-        let programs = self.programs();
-        if let Some(obj) = summary.as_object_mut() {
-            obj.insert("print_time_s".into(), serde_json::json!(self.print_time()));
-            obj.insert("robot".into(), robot);
-            obj.insert(
-                "robot_programs_written".into(),
-                serde_json::json!(programs.is_ok()),
-            );
-            obj.insert(
-                "robot_programs_why".into(),
-                serde_json::json!(programs.err()),
-            );
-            obj.insert("ok".into(), serde_json::json!(self.ok));
-            if let Ok(schedule) = self.schedule() {
-                obj.insert("schedule".into(), serde_json::json!(schedule));
-            }
-        }
-        summary
-    }
-
-    /// The print schedule (issue 11): every layer's start, end, wait and station change, from
-    /// the timed robot plan when there is one (the clock of `trajectory.csv` and the programs),
-    /// else from path length / print speed and the `[schedule]` waits. `schedule.csv` and the
-    /// `schedule` block of `summary.json` are this.
-    ///
-    /// # Errors
-    /// A `[schedule]` that does not fit the print ([`DesignError::Invalid`]).
-    pub fn schedule(&self) -> Result<crate::schedule::Schedule, DesignError> {
-        match &self.robot {
-            Some(Ok(plan)) => crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan)),
-            _ => crate::schedule::cap_schedule(&self.cap),
-        }
-    }
-
     /// The print time, s, computed once for the table, the robot line, the summary and the
     /// study row: the robot plan's total time (printing, layer changes, station changes) when
     /// there is a plan, else the path length over the print speed plus the layer changes
@@ -333,7 +254,7 @@ impl Outcome {
         match &self.robot {
             None => Err("robot planning was not run".into()),
             Some(Err(e)) => Err(format!("the robot cannot print this design: {e}")),
-            Some(Ok(_)) if !self.ok && !self.allow_fail => Err(
+            Some(Ok(_)) if !self.verdict.ok && !self.allow_fail => Err(
                 "the design fails its checks; rerun with --allow-fail (Python: allow_fail=True) \
                  to write the programs anyway"
                     .into(),
@@ -342,83 +263,40 @@ impl Outcome {
         }
     }
 
-    /// The input of the HTML report ([`crate::output::report_input::report_input`]).
-    pub fn report_input(&self) -> kappe_report::ReportInput {
-        report_input(&self.cap, &self.extras)
-    }
-
-    /// The HTML report.
-    ///
-    /// # Errors
-    /// What [`kappe_report::render_html`] rejects (a report input that does not validate).
-    pub fn report_html(&self) -> Result<String, kappe_report::ReportError> {
-        kappe_report::render_html(&self.report_input())
-    }
-
     /// The lowest buckling factor over the analysed states, if any.
     pub fn min_blf(&self) -> Option<f64> {
-        self.extras
-            .states
+        self.analysis
             .iter()
+            .flat_map(|a| &a.states)
             .filter_map(|s| s.blf)
             .fold(None, |m: Option<f64>, b| Some(m.map_or(b, |m| m.min(b))))
     }
 }
 
-/// The plan in `summary.json`: stations with their base poses, the tool, motion, time, clearance.
-fn plan_summary(plan: &kappe_robot::Plan) -> serde_json::Value {
-    serde_json::json!({
-        "planned": true,
-        "ok": true,
-        "stations": plan.stations.iter().map(|s| serde_json::json!({
-            "world_from_base": s.world_from_base,
-            "layers": s.layers.iter().map(|l| l.layer).collect::<Vec<_>>(),
-        })).collect::<Vec<_>>(),
-        "flange_from_tcp": plan.flange_from_tcp,
-        "joint_motion_rad": plan.joint_motion,
-        "cost_rad2": plan.cost,
-        "print_time_s": plan.print_time,
-        "total_time_s": plan.total_time,
-        "min_clearance_m": plan.min_clearance,
-        "min_self_distance_m": plan.min_self_distance,
-        "max_speed_ratio": plan.max_speed_ratio,
-        "max_acceleration_ratio": plan.max_acceleration_ratio,
-        "programs": plan.parts.len(),
-        "slowdowns": plan.slowdowns,
-        "layer_times": kappe_robot::layer_times(plan),
-        "geometry": plan.meshes,
-    })
-}
-
-/// The schedule of a successful robot plan (its clock: print moves, layer changes, dwell,
-/// station changes, waits), which the structural check then uses for the layers' ages; `None`
-/// without a plan (the check then uses path length / print speed and the waits).
-fn plan_schedule(
+/// The one schedule of a run: the timed robot plan's clock (print moves, layer changes, dwell,
+/// station changes, waits) when there is a plan, else path length / print speed and the
+/// `[schedule]` waits.
+///
+/// # Errors
+/// A `[schedule]` that does not fit the print, or a plan whose layers are not the cap's
+/// ([`DesignError::Invalid`], naming `schedule`).
+fn run_schedule(
     cap: &Cap,
     robot: Option<&Result<kappe_robot::Plan, kappe_robot::RobotError>>,
-) -> Result<Option<crate::schedule::Schedule>, DesignError> {
-    match robot {
-        Some(Ok(plan)) => {
-            let s = crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan))?;
-            Ok((s.layers.len() == cap.sections.layers.len()).then_some(s))
-        }
-        _ => Ok(None),
-    }
-}
-
-/// The report's schedule block: the plan's schedule (or path length / speed and the waits) with
-/// the analysis' governing checks and ages; `None` when the `[schedule]` does not fit the print
-/// (the summary then leaves the schedule out too).
-fn report_schedule(
-    cap: &Cap,
-    analysis: Option<&Analysis>,
-    schedule: Option<crate::schedule::Schedule>,
-) -> Option<kappe_report::PrintSchedule> {
-    let schedule = match schedule {
-        Some(s) => s,
-        None => crate::schedule::cap_schedule(cap).ok()?,
+) -> Result<crate::schedule::Schedule, DesignError> {
+    let schedule = match robot {
+        Some(Ok(plan)) => crate::schedule::from_robot(&crate::robot_plan::layer_schedule(plan))?,
+        _ => crate::schedule::cap_schedule(cap)?,
     };
-    Some(crate::schedule::report_schedule(cap, analysis, &schedule))
+    let layers = cap.sections.layers.len();
+    if schedule.layers.len() != layers {
+        return Err(DesignError::Invalid {
+            field: "schedule",
+            value: format!("{} layers timed", schedule.layers.len()),
+            allowed: format!("allowed: one time per printed layer ({layers})"),
+        });
+    }
+    Ok(schedule)
 }
 
 /// Plan the robot with the design's `[schedule]` waits (so the printed schedule is the checked

@@ -1,16 +1,19 @@
-//! The verdict of a design: the one place where pass or fail is decided, so that `kappe design`
-//! (its exit status), `kappe study` (the result column) and the Python `kappe.design` cannot
-//! disagree.
+//! Floor 5, **the verdict**: the one place where pass or fail is decided, from the domain
+//! results of a run (the form, the analysis, the robot plan and its base-pose tolerance check),
+//! never from the report's rows. `kappe design` (its exit status), every design of
+//! `kappe study`, `kappe optimize`'s confirmation of its optimum, ceilings and the Python
+//! package all take [`Verdict`] from [`verdict`], so they cannot disagree.
 //!
-//! With an analysis ([`crate::analysis::analyze`]) its verdict counts; without one, the
-//! preliminary checks that need no finite elements ([`preliminary_constraints`]: σ_min ≤ σ ≤
-//! σ_max in every state from the form-finding force pass, max |l_o| ≤ l_o,max). A design whose
-//! robot plan was tried and failed fails too.
+//! The constraints come from the analysis when there is one; without one from the checks that
+//! need no finite elements ([`preliminary_constraints`]: σ_min ≤ σ ≤ σ_max in every state from
+//! the form-finding force pass, max |l_o| ≤ l_o,max). A robot plan that was tried and failed
+//! fails the design; a plan that does not survive the base-pose errors of `[robot.tolerance]`
+//! fails it when `[robot.tolerance] verdict = true`.
 
-use kappe_report::{Bound, ConstraintRow};
+use serde::Serialize;
 
-use crate::form::cap::{Cap, StateSummary};
-use crate::output::report_input::ReportExtras;
+use crate::analysis::{Analysis, ConstraintResult};
+use crate::form::{Cap, StateSummary};
 
 /// Relative tolerance on stress limits. The fixed-geometry force pass balances every node to
 /// ~1e-14 relative (method.md §9), so an arch whose forces are all compressive in exact
@@ -20,15 +23,138 @@ use crate::output::report_input::ReportExtras;
 /// value as [`crate::analysis::STRESS_REL_TOL`]).
 const STRESS_RELATIVE_TOLERANCE: f64 = crate::analysis::STRESS_REL_TOL;
 
-/// Whether the design passes: the analysis verdict when there is one, else every
-/// [`preliminary_constraints`] row holds (σ_min ≤ σ ≤ σ_max in every state and
-/// max |l_o| ≤ l_o,max); and the robot could be planned, if planning was tried
-/// ([`add_robot`]). `kappe design`, `kappe study` and the Python package all decide with this function.
-pub fn design_ok(cap: &Cap, extras: &ReportExtras) -> bool {
-    extras.robot_error.is_none()
-        && extras
-            .ok
-            .unwrap_or_else(|| preliminary_constraints(cap).iter().all(|c| c.pass))
+/// Pass or fail, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Every check holds.
+    pub ok: bool,
+    /// The checks that fail (empty when `ok`), constraints first, then the robot.
+    pub failures: Vec<Failure>,
+}
+
+/// One failing check.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize, schemars::JsonSchema)]
+#[serde(tag = "check", rename_all = "snake_case")]
+pub enum Failure {
+    /// A structural constraint (`sigma_min`, `sigma_max`, `overhang_max`, `blf_min`, `strength`,
+    /// `sliding`, …) fails; values in the constraint's SI unit.
+    Constraint {
+        /// The constraint's name in the design file.
+        name: String,
+        /// The worst value over the checked states (None: nothing was checked).
+        worst: Option<f64>,
+        /// The limit.
+        limit: f64,
+        /// Unit of `worst` and `limit` (`Pa`, `m`, `1`).
+        unit: String,
+        /// State where the worst value occurs.
+        state: Option<usize>,
+        /// Element, layer or mode where it occurs.
+        element: String,
+    },
+    /// The robot cannot print the design.
+    RobotPlan {
+        /// The planner's reason.
+        reason: String,
+    },
+    /// The plan does not tolerate the base-pose errors of `[robot.tolerance]`.
+    BaseTolerance {
+        /// Position error tolerated, m.
+        position_m: f64,
+        /// Yaw error tolerated, degrees.
+        yaw_deg: f64,
+        /// The first problem found.
+        problem: String,
+    },
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Failure::Constraint {
+                name,
+                state,
+                element,
+                ..
+            } => {
+                write!(f, "{name} fails")?;
+                if let Some(s) = state {
+                    write!(f, " at state {s}")?;
+                }
+                if !element.is_empty() {
+                    write!(f, " ({element})")?;
+                }
+                Ok(())
+            }
+            Failure::RobotPlan { reason } => write!(f, "the robot cannot print it: {reason}"),
+            Failure::BaseTolerance {
+                position_m,
+                yaw_deg,
+                problem,
+            } => write!(
+                f,
+                "the plan does not tolerate base-pose errors of ±{position_m} m, ±{yaw_deg}°: \
+                 {problem}"
+            ),
+        }
+    }
+}
+
+/// The robot results the verdict looks at.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RobotResults<'a> {
+    /// The plan, or why there is none; `None` when planning was not run.
+    pub plan: Option<&'a Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The base-pose tolerance check of the plan, when run.
+    pub tolerance: Option<&'a kappe_robot::tolerance::ToleranceReport>,
+}
+
+/// The verdict of a run: the analysis' constraints (or the [`preliminary_constraints`] without
+/// one), the robot plan, and the base-pose tolerance check when the design puts it in the
+/// verdict (`[robot.tolerance] verdict = true`).
+pub fn verdict(cap: &Cap, analysis: Option<&Analysis>, robot: RobotResults<'_>) -> Verdict {
+    let preliminary;
+    let constraints: &[ConstraintResult] = match analysis {
+        Some(a) => &a.constraints,
+        None => {
+            preliminary = preliminary_constraints(cap);
+            &preliminary
+        }
+    };
+    let mut failures: Vec<Failure> = constraints
+        .iter()
+        .filter(|c| !c.pass)
+        .map(|c| Failure::Constraint {
+            name: c.name.to_string(),
+            worst: c.worst,
+            limit: c.limit,
+            unit: c.unit.to_string(),
+            state: c.state,
+            element: c.element.clone(),
+        })
+        .collect();
+    match robot.plan {
+        Some(Err(e)) => failures.push(Failure::RobotPlan {
+            reason: e.to_string(),
+        }),
+        Some(Ok(_)) => {
+            let tol = &cap.design.robot.tolerance;
+            if tol.verdict
+                && let Some(r) = robot.tolerance.filter(|r| !r.ok())
+            {
+                failures.push(Failure::BaseTolerance {
+                    position_m: tol.position,
+                    yaw_deg: tol.yaw_deg,
+                    problem: r.problems.first().cloned().unwrap_or_default(),
+                });
+            }
+        }
+        None => {}
+    }
+    Verdict {
+        ok: failures.is_empty(),
+        failures,
+    }
 }
 
 /// Stress tolerance in Pa (see [`STRESS_RELATIVE_TOLERANCE`]).
@@ -63,11 +189,11 @@ pub(crate) fn state_ok_preliminary(cap: &Cap, state: &StateSummary, tol: f64) ->
         && max_overhang(cap, state.layers_printed) <= cap.design.overhang_max()
 }
 
-/// The constraints checkable without the finite-element analysis, worst value over all states:
-/// `sigma_min` (most compressive stress ≥ σ_min), `sigma_max` (largest stress ≤ σ_max), both
-/// in kPa, and `overhang_max` (max |l_o| ≤ l_o,max, mm). The names are those of
-/// [`crate::analysis::analyze`], so its rows replace these.
-pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintRow> {
+/// The constraints checkable without the finite-element analysis, worst value over all states,
+/// in SI units: `sigma_min` (most compressive stress ≥ σ_min, Pa), `sigma_max` (largest stress
+/// ≤ σ_max, Pa) and `overhang_max` (max |l_o| ≤ l_o,max, m). The names are those of
+/// [`crate::analysis::analyze`], whose rows replace these.
+pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintResult> {
     let k = &cap.design.constraints;
     let tol = stress_tolerance(cap);
     let mut worst_c: (f64, Option<usize>) = (0.0, None);
@@ -100,36 +226,116 @@ pub fn preliminary_constraints(cap: &Cap) -> Vec<ConstraintRow> {
             .map(|l| format!("layer {} over the layer before it", l.id))
     };
     let lo_max = cap.design.overhang_max();
+    let states = cap.states.len();
     vec![
-        ConstraintRow {
-            name: "sigma_min".into(),
-            bound: Bound::AtLeast,
-            limit: k.sigma_min / 1e3,
-            worst: worst_c.0 / 1e3,
-            unit: "kPa".into(),
+        ConstraintResult {
+            name: "sigma_min",
+            description: "most compressive stress ≥ σ_min (form-finding force pass)",
+            limit: k.sigma_min,
+            worst: Some(worst_c.0),
             state: worst_c.1,
-            element: None,
+            element: String::new(),
             pass: worst_c.0 >= k.sigma_min - tol,
+            unit: "Pa",
+            states_checked: states,
         },
-        ConstraintRow {
-            name: "sigma_max".into(),
-            bound: Bound::AtMost,
-            limit: k.sigma_max / 1e3,
-            worst: worst_t.0 / 1e3,
-            unit: "kPa".into(),
+        ConstraintResult {
+            name: "sigma_max",
+            description: "largest stress ≤ σ_max (form-finding force pass)",
+            limit: k.sigma_max,
+            worst: Some(worst_t.0),
             state: worst_t.1,
-            element: None,
+            element: String::new(),
             pass: worst_t.0 <= k.sigma_max + tol,
+            unit: "Pa",
+            states_checked: states,
         },
-        ConstraintRow {
-            name: "overhang_max".into(),
-            bound: Bound::AtMost,
-            limit: lo_max * 1e3,
-            worst: worst_o.0 * 1e3,
-            unit: "mm".into(),
+        ConstraintResult {
+            name: "overhang_max",
+            description: "largest layer overhang |l_o| ≤ l_o,max",
+            limit: lo_max,
+            worst: Some(worst_o.0),
             state: worst_o.1,
-            element: worst_o.1.and_then(layer_name),
+            element: worst_o.1.and_then(layer_name).unwrap_or_default(),
             pass: worst_o.0 <= lo_max,
+            unit: "m",
+            states_checked: states,
         },
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cheap_cap(toml: &str) -> Cap {
+        // 3 centre layers and lh = 15 mm: a few start layers, a fast design.
+        let design = crate::Design::from_toml_str(&format!(
+            "[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n{toml}"
+        ))
+        .unwrap();
+        crate::design_cap(&design, &|_| {}).unwrap()
+    }
+
+    #[test]
+    fn preliminary_verdict_follows_the_stress_limit() {
+        // The default cheap cap passes; the same cap with σ_min above its most compressive
+        // stress (a limit it must fail) fails on sigma_min only.
+        let cap = cheap_cap("");
+        let v = verdict(&cap, None, RobotResults::default());
+        assert!(v.ok, "{:?}", v.failures);
+        let worst = cap
+            .states
+            .iter()
+            .map(|s| s.forces.max_compression_stress)
+            .fold(0.0, f64::min);
+        let strict = cheap_cap(&format!("[constraints]\nsigma_min = {}\n", worst / 2.0));
+        let v = verdict(&strict, None, RobotResults::default());
+        assert!(!v.ok);
+        assert_eq!(v.failures.len(), 1);
+        assert!(
+            matches!(&v.failures[0], Failure::Constraint { name, .. } if name == "sigma_min"),
+            "{:?}",
+            v.failures
+        );
+    }
+
+    #[test]
+    fn the_analysis_decides_when_present_and_agrees_with_the_preliminary_checks() {
+        let cap = cheap_cap("");
+        let options = crate::analysis::AnalysisOptions {
+            // Stresses and overhang only: the FE buckling solve is tested elsewhere.
+            buckling: false,
+            ..Default::default()
+        };
+        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let with = verdict(&cap, Some(&analysis), RobotResults::default());
+        let without = verdict(&cap, None, RobotResults::default());
+        assert_eq!(with.ok, without.ok);
+        // An analysis that fails a constraint fails the design, whatever the preliminary
+        // checks say.
+        let mut failing = analysis.clone();
+        if let Some(c) = failing.constraints.first_mut() {
+            c.pass = false;
+        }
+        let v = verdict(&cap, Some(&failing), RobotResults::default());
+        assert!(!v.ok);
+        assert_eq!(v.failures.len(), 1);
+    }
+
+    #[test]
+    fn a_failed_robot_plan_fails_the_design() {
+        let cap = cheap_cap("");
+        let plan = Err(kappe_robot::RobotError::Verification(vec!["test".into()]));
+        let v = verdict(
+            &cap,
+            None,
+            RobotResults {
+                plan: Some(&plan),
+                tolerance: None,
+            },
+        );
+        assert!(!v.ok);
+        assert!(matches!(v.failures[0], Failure::RobotPlan { .. }));
+    }
 }

@@ -228,7 +228,7 @@ fn shell_model_rows_supports_and_orientation() {
     let last = c.states.len() - 1;
     let state = build_state(&c.sections, &c.frame, 0.0, last).unwrap();
     let o = AnalysisOptions::default();
-    let sh = state_shell(&state, &state_material(&c, &o, last), 1).unwrap();
+    let sh = state_shell(&state, &state_material(&c, &o, last).unwrap(), 1).unwrap();
     // Consistent orientation, no degenerate facet, every node used.
     sh.model.validate().unwrap();
     // One row per printed layer, in print order.
@@ -289,11 +289,11 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
     let last = c.states.len() - 1;
     let state = build_state(&c.sections, &c.frame, 0.0, last).unwrap();
     let o = AnalysisOptions::default();
-    let b1 = state_buckling(&state, &state_material(&c, &o, last), &o).unwrap();
+    let b1 = state_buckling(&state, &state_material(&c, &o, last).unwrap(), &o).unwrap();
     let mut d2 = d.clone();
     d2.material.youngs_modulus *= 2.0;
     let c2 = cap(&d2);
-    let b2 = state_buckling(&state, &state_material(&c2, &o, last), &o).unwrap();
+    let b2 = state_buckling(&state, &state_material(&c2, &o, last).unwrap(), &o).unwrap();
     // Linear buckling under dead load: BLF ∝ E exactly (buckling.md A11); 1e-6 covers the
     // Lanczos tolerance of 1e-8 on μ.
     assert!((b2.factors[0] / b1.factors[0] - 2.0).abs() < 1e-6);
@@ -307,7 +307,7 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
         }),
         ..AnalysisOptions::default()
     };
-    let m = state_material(&c, &aged, last);
+    let m = state_material(&c, &aged, last).unwrap();
     // The top layer is fresh, older ones stiffer, none above E_max.
     let top_id = c.sections.layers[last].id;
     assert_eq!(m.modulus_of(top_id), e);
@@ -327,7 +327,7 @@ fn mechanism_is_reported_with_its_layer() {
     let q = 3;
     let state = build_state(&c.sections, &c.frame, 0.0, q).unwrap();
     let o = AnalysisOptions::default();
-    let mut sh = state_shell(&state, &state_material(&c, &o, q), 1).unwrap();
+    let mut sh = state_shell(&state, &state_material(&c, &o, q).unwrap(), 1).unwrap();
     sh.model.supports.clear();
     let b = kappe::analysis::shell_buckling(&sh, q, &o).unwrap();
     assert_eq!(b.status, BucklingStatus::Mechanism);

@@ -21,7 +21,7 @@ fn final_blf(d: &Design) -> f64 {
         row_stride: 4,
         ..AnalysisOptions::default()
     };
-    state_buckling(&state, &state_material(&cap, &o, last), &o)
+    state_buckling(&state, &state_material(&cap, &o, last).unwrap(), &o)
         .unwrap()
         .factors[0]
 }

@@ -29,7 +29,7 @@ fn three_bay_ceiling_end_to_end() {
     })
     .unwrap();
     assert_eq!(out.bays.len(), 3);
-    let s = out.summary();
+    let s = serde_json::to_value(out.summary()).unwrap();
     let bays = s["bays"].as_array().unwrap();
     let mut mass = 0.0;
     for (b, row) in out.bays.iter().zip(bays) {
@@ -113,32 +113,34 @@ fn base_tolerance_in_the_design_pipeline() {
     assert!(zero.robot.as_ref().is_some_and(|p| p.is_ok()));
     let t = zero.base_tolerance.as_ref().unwrap();
     assert!(t.ok(), "{:?}", t.problems);
-    assert_eq!(zero.summary()["robot"]["base_tolerance"]["ok"], true);
+    assert_eq!(
+        serde_json::to_value(zero.summary()).unwrap()["robot"]["base_tolerance"]["ok"],
+        true
+    );
 
     d.robot.tolerance.position = 0.3;
     d.robot.tolerance.yaw_deg = 20.0;
     d.robot.tolerance.stride = 8;
     let far = kappe::run(&d, &options, &go).unwrap();
     assert!(!far.base_tolerance.as_ref().unwrap().ok());
-    let s = far.summary();
+    let s = serde_json::to_value(far.summary()).unwrap();
     assert_eq!(s["robot"]["base_tolerance"]["ok"], false);
     assert_eq!(s["robot"]["base_tolerance"]["in_verdict"], false);
     // Reported only: the verdict is the one without the check.
-    assert_eq!(far.ok, zero.ok);
+    assert_eq!(far.verdict.ok, zero.verdict.ok);
 
     d.robot.tolerance.verdict = true;
     let enforced = kappe::run(&d, &options, &go).unwrap();
     assert!(
-        !enforced.ok,
+        !enforced.verdict.ok,
         "with verdict = true the failure fails the design"
     );
     assert!(
-        enforced
-            .extras
-            .robot_error
-            .as_deref()
-            .is_some_and(|e| e.contains("base-pose errors")),
+        enforced.verdict.failures.iter().any(|f| matches!(
+            f,
+            kappe::verdict::Failure::BaseTolerance { .. }
+        ) && f.to_string().contains("base-pose errors")),
         "{:?}",
-        enforced.extras.robot_error
+        enforced.verdict.failures
     );
 }

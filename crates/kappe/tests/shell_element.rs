@@ -43,7 +43,7 @@ fn final_state_blf_drops_by_the_shear_share() {
             element,
             ..AnalysisOptions::default()
         };
-        state_buckling(&state, &state_material(&cap, &o, last), &o)
+        state_buckling(&state, &state_material(&cap, &o, last).unwrap(), &o)
             .unwrap()
             .factors[0]
     };

@@ -227,7 +227,7 @@ impl PyOutcome {
     /// The verdict (`summary["ok"]`).
     #[getter]
     fn ok(&self) -> bool {
-        self.out.ok
+        self.out.verdict.ok
     }
 
     /// The print time, s (the robot plan's when planned).

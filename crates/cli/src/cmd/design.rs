@@ -97,7 +97,15 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     let summary = eval.summary();
     let table = || eval.table(&args.out, programs);
     let failures = |level: &str| eval.failure_lines(level);
-    finish(&args, prepared, &files, &summary, table, failures, eval.ok)
+    finish(
+        &args,
+        prepared,
+        &files,
+        &summary,
+        table,
+        failures,
+        eval.verdict.ok,
+    )
 }
 
 /// The end of every design run: write the output, print the summary (JSON or the table), the
@@ -106,7 +114,7 @@ fn finish(
     args: &DesignArgs,
     prepared: crate::output::PreparedDir,
     files: &[kappe::output::OutputFile],
-    summary: &serde_json::Value,
+    summary: &impl serde::Serialize,
     table: impl FnOnce() -> String,
     failure_lines: impl FnOnce(&str) -> Vec<String>,
     ok: bool,

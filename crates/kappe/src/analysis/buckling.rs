@@ -9,12 +9,13 @@ use serde::Serialize;
 use crate::analysis::shell::{NoShell, ShellMaterial, StateShell, state_shell};
 use crate::form::cap::Cap;
 use crate::form::states::State;
-use crate::input::ageing::layer_ages;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 
 /// What the buckling analysis of a state did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum BucklingStatus {
     /// Analysed; `blf` holds the factor.
@@ -29,19 +30,22 @@ pub enum BucklingStatus {
     NoPositiveFactor,
 }
 
-/// The shell material of the state with top print index `top`: the design's material, with
-/// every layer's modulus from its age when `options.ageing` is set.
-pub fn state_material(cap: &Cap, options: &AnalysisOptions, top: usize) -> ShellMaterial {
-    state_material_with(
-        cap,
-        options,
-        top,
-        crate::analysis::green::CapGreen::new(cap).ok().as_ref(),
-    )
+/// The shell material of the state with top print index `top`: the design's material, every
+/// layer's modulus from its age on the cap's schedule when the time model varies with age.
+///
+/// # Errors
+/// An invalid time model or a `[schedule]` that does not fit the print.
+pub fn state_material(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    top: usize,
+) -> Result<ShellMaterial, DesignError> {
+    let green = crate::analysis::green::CapGreen::new(cap)?;
+    Ok(state_material_with(cap, options, top, Some(&green)))
 }
 
-/// [`state_material`] with the layers' ages from `green`'s schedule (e.g. the robot plan's
-/// clock); `None`: the material without a time model.
+/// [`state_material`] with the layers' ages from `green`'s schedule (the run's one clock, e.g.
+/// the robot plan's); `None`: the material without a time model.
 pub fn state_material_with(
     cap: &Cap,
     options: &AnalysisOptions,
@@ -49,15 +53,10 @@ pub fn state_material_with(
     green: Option<&crate::analysis::green::CapGreen>,
 ) -> ShellMaterial {
     let d = &cap.design;
-    let layer_modulus = match &options.ageing {
-        // `[material.time]` (issue 11): E per layer from its age on the cap's schedule; empty
-        // for the constant model, so the shell is exactly the one without a time model.
-        None => green.map_or_else(HashMap::new, |g| g.layer_moduli(cap, top)),
-        Some(a) => layer_ages(&cap.sections, d.print.print_speed, top)
-            .into_iter()
-            .map(|(id, t)| (id, a.modulus(t)))
-            .collect(),
-    };
+    // E per layer from its age on the schedule (`[material.time]`, or the older
+    // `[analysis.ageing]` read as the linear time model); empty for the constant model, so the
+    // shell is exactly the one without a time model.
+    let layer_modulus = green.map_or_else(HashMap::new, |g| g.layer_moduli(cap, top));
     ShellMaterial {
         thickness: d.print.layer_width,
         poisson_ratio: d.material.poisson_ratio,

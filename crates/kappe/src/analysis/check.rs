@@ -91,7 +91,7 @@ pub struct ConstraintResult {
 
 /// Wall-clock split of [`analyze`], seconds (states run in parallel, so the per-state sums
 /// exceed the wall-clock phases on several cores).
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize, schemars::JsonSchema)]
 pub struct Timings {
     /// Phase 1, wall clock: rebuilding every state, its force pass and element stresses.
     pub stresses: f64,

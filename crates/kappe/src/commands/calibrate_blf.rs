@@ -175,7 +175,7 @@ fn state_blfs(
         .filter(|&&s| s < total)
         .map(|&s| {
             let st = build_state(&cap.sections, &cap.frame, phi, s)?;
-            let b = state_buckling(&st, &state_material(cap, options, s), options)?;
+            let b = state_buckling(&st, &state_material(cap, options, s)?, options)?;
             match b.status {
                 BucklingStatus::Analysed => Ok(b.factors.first().map(|&f| (s, f))),
                 // A mechanism cannot stand: BLF 0.

@@ -334,7 +334,7 @@ impl CeilingOutcome {
     /// The ceiling of `bays` (in order, as [`run_bay`] returns them).
     pub fn from_bays(ceiling: &CeilingDesign, bays: Vec<BayOutcome>) -> Self {
         let ok = bays.iter().all(|b| {
-            b.outcome.ok
+            b.outcome.verdict.ok
                 && b.mirror_plan.as_ref().is_none_or(|p| p.is_ok())
                 && !(b.design.robot.tolerance.verdict
                     && b.mirror_tolerance.as_ref().is_some_and(|t| !t.ok()))
@@ -513,7 +513,7 @@ impl BayOutcome {
             "closure_gap_m": (self.halves == 2).then(|| 2.0 * crate::form::ends::far_end_gap(self.design.cap.rise, self.design.tilt())),
             "worst_constraint": self.worst_constraint(),
             "min_blf": self.outcome.min_blf(),
-            "ok": self.outcome.ok && failures.is_empty() && !tolerance_fails,
+            "ok": self.outcome.verdict.ok && failures.is_empty() && !tolerance_fails,
         })
     }
 }
@@ -590,7 +590,11 @@ impl CeilingOutcome {
                 i + 1,
                 bay.design.cap.span,
                 bay.halves,
-                if bay.outcome.ok { "passes" } else { "FAILS" }
+                if bay.outcome.verdict.ok {
+                    "passes"
+                } else {
+                    "FAILS"
+                }
             ));
         }
         t
@@ -601,7 +605,7 @@ impl CeilingOutcome {
     pub fn failure_lines(&self, level: &str) -> Vec<String> {
         (1..)
             .zip(&self.bays)
-            .filter(|(_, b)| !b.outcome.ok)
+            .filter(|(_, b)| !b.outcome.verdict.ok)
             .map(|(n, _)| format!("{level}: bay {n} fails its checks (see bay_{n}/report.html)"))
             .collect()
     }
@@ -632,7 +636,7 @@ impl BayOutcome {
             OutputFile::new("report.html", report),
             OutputFile::new("path.csv", eval.cap.path.to_csv()),
         ];
-        if eval.ok || allow_fail {
+        if eval.verdict.ok || allow_fail {
             if let Some(Ok(plan)) = &eval.robot {
                 out.extend(plan_files(plan, "program_part", true)?);
             }

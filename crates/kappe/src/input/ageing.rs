@@ -1,9 +1,8 @@
-//! Linear ageing of the green material (buckling.md §6, Wolfs et al. 2018): a layer's modulus
-//! grows with the time since it was printed.
+//! `[analysis.ageing]`, the older form of `[material.time]` (linear E only): read as that time
+//! model ([`crate::input::Design::time_model`]), so a layer's age always comes from the run's
+//! one clock ([`crate::schedule`]).
 
 use serde::{Deserialize, Serialize};
-
-use crate::form::section::Sections;
 
 /// Linear ageing of the green material (buckling.md §6, Wolfs et al. 2018):
 /// `E(t) = min(E₀ + Ė·t, E_max)`, t the age of a layer at the state (time since it was printed).
@@ -28,18 +27,4 @@ impl Ageing {
             None => e,
         }
     }
-}
-
-/// Age of every layer (print order) at the state whose top has print index `top`, s: the print
-/// time of the layers printed after it (layer length / `print_speed`).
-pub fn layer_ages(sections: &Sections, print_speed: f64, top: usize) -> Vec<(i32, f64)> {
-    let layers = &sections.layers;
-    let mut ages = Vec::with_capacity(top + 1);
-    let mut t = 0.0;
-    for q in (0..=top.min(layers.len().saturating_sub(1))).rev() {
-        ages.push((layers[q].id, t));
-        t += layers[q].length() / print_speed;
-    }
-    ages.reverse();
-    ages
 }

@@ -33,7 +33,7 @@ impl OutputFile {
     }
 }
 
-fn json(name: &str, value: &serde_json::Value) -> Result<OutputFile> {
+fn json(name: &str, value: &impl serde::Serialize) -> Result<OutputFile> {
     serde_json::to_vec_pretty(value)
         .map(|b| OutputFile::new(name, b))
         .map_err(|e| OutputError::Produce(format!("cannot write {name}: {e}")))
@@ -86,9 +86,7 @@ impl Outcome {
             OutputFile::new("report.html", report),
         ];
         // The layer times the structural check and the robot share (issue 11).
-        if let Ok(schedule) = self.schedule() {
-            out.push(OutputFile::new("schedule.csv", schedule.to_csv()));
-        }
+        out.push(OutputFile::new("schedule.csv", self.schedule.to_csv()));
         if let Some(Ok(plan)) = &self.robot {
             out.extend(plan_files(plan, "program_part", self.programs().is_ok())?);
         }
@@ -220,7 +218,7 @@ impl Outcome {
         if let Some(Err(e)) = &self.robot {
             lines.push(format!("{level}: the robot cannot print this design: {e}"));
         }
-        if !self.ok {
+        if !self.verdict.ok {
             for c in self.analysis.iter().flat_map(|a| a.failing()) {
                 lines.push(format!(
                     "{level}: constraint {} fails: worst {} {} against the limit {} {}{}",

@@ -11,6 +11,8 @@ pub mod dir;
 mod files;
 pub mod network;
 pub mod report_input;
+pub mod schedule_report;
+pub mod summary;
 
 pub use dir::{
     MANIFEST, PreparedDir, check_user_file, prepare_dir, write_file_atomic, write_user_file,

@@ -27,8 +27,8 @@
 //! - `worst_places`: σ_min/σ_max at the midpoint of the extreme element of the worst state (one
 //!   force pass of that state), BLF at the peak of that state's mode 1, the overhang at the
 //!   crown of its layer (with the signed l_o).
-//! - `quantities`: with layer ageing in the analysis, each printed layer's age and modulus per
-//!   state, as the buckling analysis used them ([`crate::input::ageing`]).
+//! - `quantities`: with a time model, each printed layer's age and modulus per state, on the
+//!   run's one clock ([`crate::schedule::Schedule::ages`]), as the analysis used them.
 
 use std::collections::HashMap;
 
@@ -38,7 +38,7 @@ use kappe_report::{
     WorstPlace,
 };
 
-use crate::analysis::{Ageing, NetworkMode};
+use crate::analysis::NetworkMode;
 
 use crate::form::cap::Cap;
 use crate::verdict::{
@@ -70,13 +70,8 @@ pub struct ReportExtras {
     /// row of the same `name` (`sigma_min`, `sigma_max`, `overhang_max`); other rows (`blf_min`,
     /// robot checks) are appended.
     pub constraints: Vec<ConstraintRow>,
-    /// The analysis verdict over all constraints; `None` until the analysis exists.
-    pub ok: Option<bool>,
     /// The robot moving along its trajectory.
     pub robot: Option<RobotAnimation>,
-    /// Why the robot cannot print the design, if planning was tried and failed (the design then
-    /// fails, as `kappe design` exits non-zero for it).
-    pub robot_error: Option<String>,
     /// Extra plots after the standard ones.
     pub plots: Vec<Plot>,
     /// Arrival time of every waypoint of the plan, by (layer id, point index), s.
@@ -87,8 +82,9 @@ pub struct ReportExtras {
     pub cell: Option<Cell>,
     /// Mode 1 of each analysed state: state position, its BLF, translations per network node.
     pub modes: Vec<(usize, f64, NetworkMode)>,
-    /// The layer ageing the analysis used, if any.
-    pub ageing: Option<Ageing>,
+    /// The time model and the run's schedule, when the modulus varies with age: the layers'
+    /// ages and moduli as the analysis used them.
+    pub clock: Option<(crate::input::material::TimeModel, crate::schedule::Schedule)>,
     /// The print schedule, governing checks and layer ages (`crate::schedule::report_schedule`).
     pub schedule: Option<kappe_report::PrintSchedule>,
     /// The robot plan's slowdowns and clearances ([`robot_summary`]).
@@ -108,33 +104,7 @@ pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtra
             ok: s.ok,
         })
         .collect();
-    let constraints = analysis
-        .constraints
-        .iter()
-        .filter_map(|c| {
-            let worst = c.worst?;
-            let (scale, unit) = match c.unit {
-                "Pa" => (1e-3, "kPa"),
-                "m" => (1e3, "mm"),
-                "1" => (1.0, ""),
-                other => (1.0, other),
-            };
-            let bound = match c.name {
-                "sigma_max" | "overhang_max" => Bound::AtMost,
-                _ => Bound::AtLeast,
-            };
-            Some(ConstraintRow {
-                name: c.name.to_string(),
-                bound,
-                limit: c.limit * scale,
-                worst: worst * scale,
-                unit: unit.to_string(),
-                state: c.state,
-                element: (!c.element.is_empty()).then(|| c.element.clone()),
-                pass: c.pass,
-            })
-        })
-        .collect();
+    let constraints = analysis.constraints.iter().filter_map(row_of).collect();
     let modes = analysis
         .states
         .iter()
@@ -145,11 +115,35 @@ pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtra
     ReportExtras {
         states,
         constraints,
-        ok: Some(analysis.ok),
         modes,
-        ageing: analysis.options.ageing,
         ..ReportExtras::default()
     }
+}
+
+/// A constraint in the report's units (stresses in kPa, overhang in mm; the analysis gives Pa
+/// and m); `None` when no state was checked for it (no worst value).
+fn row_of(c: &crate::analysis::ConstraintResult) -> Option<ConstraintRow> {
+    let worst = c.worst?;
+    let (scale, unit) = match c.unit {
+        "Pa" => (1e-3, "kPa"),
+        "m" => (1e3, "mm"),
+        "1" => (1.0, ""),
+        other => (1.0, other),
+    };
+    let bound = match c.name {
+        "sigma_max" | "overhang_max" => Bound::AtMost,
+        _ => Bound::AtLeast,
+    };
+    Some(ConstraintRow {
+        name: c.name.to_string(),
+        bound,
+        limit: c.limit * scale,
+        worst: worst * scale,
+        unit: unit.to_string(),
+        state: c.state,
+        element: (!c.element.is_empty()).then(|| c.element.clone()),
+        pass: c.pass,
+    })
 }
 
 /// The arm posed along the robot plan (`crate::robot_plan::arm_frames`) as the report's
@@ -273,10 +267,7 @@ pub fn add_robot(
                 ),
             )
         }
-        Err(e) => {
-            extras.robot_error = Some(e.to_string());
-            (false, e.to_string())
-        }
+        Err(e) => (false, e.to_string()),
     };
     extras.constraints.push(ConstraintRow {
         name: "robot_plan".into(),
@@ -382,7 +373,10 @@ pub fn robot_summary(p: &kappe_robot::Plan) -> kappe_report::RobotSummary {
 
 /// The constraint table: preliminary rows, replaced or extended by the analysis rows.
 fn constraint_rows(cap: &Cap, extras: &ReportExtras) -> Vec<ConstraintRow> {
-    let mut rows = preliminary_constraints(cap);
+    let mut rows: Vec<ConstraintRow> = preliminary_constraints(cap)
+        .iter()
+        .filter_map(row_of)
+        .collect();
     for row in &extras.constraints {
         match rows.iter_mut().find(|r| r.name == row.name) {
             Some(slot) => *slot = row.clone(),
@@ -707,25 +701,20 @@ fn mode_shapes(cap: &Cap, extras: &ReportExtras) -> Vec<ModeShape> {
         .collect()
 }
 
-/// With layer ageing: the age (min) and the modulus (MPa) of every printed layer in every state.
+/// With a time model: the age (min) and the modulus (MPa) of every printed layer in every
+/// state, on the run's clock.
 fn ageing_quantities(cap: &Cap, extras: &ReportExtras) -> Vec<Quantity> {
-    let Some(ageing) = extras.ageing else {
+    let Some((time, schedule)) = &extras.clock else {
         return Vec::new();
     };
-    let speed = cap.design.print.print_speed;
     let ages: Vec<Vec<f64>> = cap
         .states
         .iter()
-        .map(|s| {
-            crate::input::ageing::layer_ages(&cap.sections, speed, s.layers_printed - 1)
-                .into_iter()
-                .map(|(_, t)| t)
-                .collect()
-        })
+        .map(|s| schedule.ages(s.layers_printed))
         .collect();
     let moduli = ages
         .iter()
-        .map(|a| a.iter().map(|&t| ageing.modulus(t)).collect())
+        .map(|a| a.iter().map(|&t| time.modulus(t)).collect())
         .collect();
     vec![
         Quantity {
@@ -736,7 +725,10 @@ fn ageing_quantities(cap: &Cap, extras: &ReportExtras) -> Vec<Quantity> {
             per: QuantityPer::Layer,
             diverging: false,
             states: ages,
-            note: Some("time since the layer was printed, at the print speed (as the buckling analysis ages it)".into()),
+            note: Some(
+                "time since the layer was printed, on the run's clock (as the analysis ages it)"
+                    .into(),
+            ),
         },
         Quantity {
             key: "layer_modulus".into(),
@@ -746,7 +738,7 @@ fn ageing_quantities(cap: &Cap, extras: &ReportExtras) -> Vec<Quantity> {
             per: QuantityPer::Layer,
             diverging: false,
             states: moduli,
-            note: Some("Young's modulus of the green layer at its age (linear ageing)".into()),
+            note: Some("Young's modulus of the green layer at its age (the time model)".into()),
         },
     ]
 }
@@ -829,10 +821,59 @@ fn worst_places(cap: &Cap, input: &ReportInput) -> Vec<WorstPlace> {
     }
 }
 
+impl crate::Outcome {
+    /// The input of the HTML report: the cap with the analysis, the robot plan, the schedule
+    /// and the verdict's robot failures.
+    pub fn report_input(&self) -> ReportInput {
+        let mut extras = self
+            .analysis
+            .as_ref()
+            .map(extras_from_analysis)
+            .unwrap_or_default();
+        if let Some(plan) = &self.robot {
+            add_robot(&mut extras, plan);
+        }
+        for f in &self.verdict.failures {
+            if let crate::verdict::Failure::BaseTolerance { problem, .. } = f {
+                extras.constraints.push(ConstraintRow {
+                    name: "base_tolerance".into(),
+                    bound: Bound::AtMost,
+                    limit: 0.0,
+                    worst: 1.0,
+                    unit: "failures".into(),
+                    state: None,
+                    element: Some(format!("{f}; first: {problem}")),
+                    pass: false,
+                });
+            }
+        }
+        extras.schedule = Some(crate::output::schedule_report::report_schedule(
+            &self.cap,
+            self.analysis.as_ref(),
+            &self.schedule,
+        ));
+        extras.clock = self
+            .cap
+            .design
+            .time_model()
+            .ok()
+            .filter(|t| !t.is_constant())
+            .map(|t| (t, self.schedule.clone()));
+        report_input(&self.cap, &extras)
+    }
+
+    /// The HTML report.
+    ///
+    /// # Errors
+    /// What [`kappe_report::render_html`] rejects (a report input that does not validate).
+    pub fn report_html(&self) -> Result<String, kappe_report::ReportError> {
+        kappe_report::render_html(&self.report_input())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::verdict::design_ok;
 
     fn cheap_cap() -> Cap {
         // 3 centre layers and lh = 15 mm: a few start layers, a fast design.
@@ -886,15 +927,12 @@ mod tests {
                 element: None,
                 pass: true,
             }],
-            ok: Some(false),
             ..ReportExtras::default()
         };
         let input = report_input(&cap, &extras);
         let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, ["sigma_min", "sigma_max", "overhang_max", "blf"]);
         assert!(input.states.iter().all(|s| s.blf == Some(3.0) && s.ok));
-        // The analysis verdict wins over the preliminary one.
-        assert!(!design_ok(&cap, &extras));
     }
 
     #[test]
@@ -912,7 +950,10 @@ mod tests {
         input.validate().unwrap();
         // blf_min was checked in no state, so it has no row; the other three replace the
         // preliminary rows and must agree with them in verdict, limit and worst value.
-        let pre = preliminary_constraints(&cap);
+        let pre: Vec<ConstraintRow> = preliminary_constraints(&cap)
+            .iter()
+            .filter_map(row_of)
+            .collect();
         assert_eq!(input.constraints.len(), pre.len());
         for (a, p) in input.constraints.iter().zip(&pre) {
             assert_eq!(
@@ -930,10 +971,6 @@ mod tests {
                 "{a:?} {p:?}"
             );
         }
-        assert_eq!(
-            design_ok(&cap, &extras),
-            design_ok(&cap, &ReportExtras::default())
-        );
         for (s, p) in input
             .states
             .iter()

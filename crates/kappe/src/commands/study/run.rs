@@ -13,7 +13,7 @@ pub struct DesignRun {
     /// The row of `study.csv` / `study.json`.
     pub record: Record,
     /// `designs/<name>/summary.json` (the same as `kappe design` writes), if the design ran.
-    pub summary: Option<serde_json::Value>,
+    pub summary: Option<crate::output::summary::Summary>,
     /// `designs/<name>/report.html`, if the design ran.
     pub report_html: Option<String>,
 }
@@ -96,7 +96,11 @@ pub fn run_one(v: &Variation, parameters: Vec<String>, no_robot: bool) -> Design
             index: v.index,
             name: v.name.clone(),
             parameters: parameters.clone(),
-            outcome: if out.ok { Verdict::Pass } else { Verdict::Fail },
+            outcome: if out.verdict.ok {
+                Verdict::Pass
+            } else {
+                Verdict::Fail
+            },
             error: None,
             max_compression_stress_pa: Some(fold(
                 |s| s.forces.max_compression_stress,
