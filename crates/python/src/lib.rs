@@ -57,8 +57,10 @@ fn json_err(what: &str, e: impl std::fmt::Display) -> PyErr {
 
 /// The embedded default design as TOML.
 #[pyfunction]
-fn default_design_toml() -> String {
-    kappe::Design::default().to_toml_string()
+fn default_design_toml() -> PyResult<String> {
+    kappe::Design::default()
+        .to_toml_string()
+        .map_err(|e| design_error(&e))
 }
 
 /// The commented example design file (`kappe init`).
@@ -71,7 +73,7 @@ fn example_design_toml() -> &'static str {
 #[pyfunction]
 fn design_from_toml(text: &str) -> PyResult<String> {
     let d = kappe::Design::from_toml_str(text).map_err(|e| design_error(&e))?;
-    Ok(d.to_toml_string())
+    d.to_toml_string().map_err(|e| design_error(&e))
 }
 
 /// Parse and validate a design given as JSON text (a dict in the design file's schema);
@@ -97,6 +99,7 @@ fn design_to_json(text: &str) -> PyResult<String> {
     let d = kappe::Design::from_toml_str(text).map_err(|e| design_error(&e))?;
     let table: toml::Table = d
         .to_toml_string()
+        .map_err(|e| design_error(&e))?
         .parse()
         .map_err(|e| json_err("design TOML", e))?;
     serde_json::to_string(&table).map_err(|e| json_err("design JSON", e))
@@ -767,7 +770,10 @@ fn optimize_design(
     let doc = optimize::document(&file, &result).map_err(|e| design_error(&e))?;
     let json = serde_json::to_string_pretty(&doc).map_err(|e| json_err("optimize.json", e))?;
     Ok((
-        result.design.to_toml_string(),
+        result
+            .design
+            .to_toml_string()
+            .map_err(|e| design_error(&e))?,
         json,
         result.report(),
         result.feasible,

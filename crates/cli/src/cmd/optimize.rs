@@ -78,7 +78,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
 
     let doc = optimize::document(&file, &result)?;
     let dir = prepared.path();
-    std::fs::write(dir.join("design.toml"), result.design.to_toml_string())?;
+    std::fs::write(dir.join("design.toml"), result.design.to_toml_string()?)?;
     std::fs::write(dir.join("optimize.json"), serde_json::to_vec_pretty(&doc)?)?;
     if let Some(notice) = prepared.commit()? {
         eprintln!("note: {notice}");

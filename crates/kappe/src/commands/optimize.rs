@@ -290,7 +290,8 @@ pub struct OptimizeResult {
     pub start_volume_m3: Option<f64>,
     /// Every evaluation in order (`accepted` marks the path taken).
     pub evaluations: Vec<Evaluation>,
-    /// All constraints hold in the verification analysis.
+    /// The result passes `kappe design`'s verdict (every constraint of the verification
+    /// analysis, the robot plan, the base tolerance when in the verdict).
     pub feasible: bool,
     /// Constraints that bind: failing ones if infeasible, else those within 5 % of their limit.
     pub binding: Vec<String>,
@@ -298,6 +299,9 @@ pub struct OptimizeResult {
     pub at_bounds: Vec<String>,
     /// The verification analysis of the result (None if it could not be built).
     pub verification: Option<Analysis>,
+    /// The verdict of `kappe design`'s run on the result (analysis, robot plan, base
+    /// tolerance); `feasible` is its `ok`. None if the design could not be run.
+    pub verdict: Option<crate::verdict::Verdict>,
 }
 
 /// Relative violation of each failing constraint of an analysis.
@@ -467,11 +471,31 @@ pub fn optimize_until(
         }
     }
 
-    let design = to_design(&x);
-    let (volume, _, failing, verification) = evaluate(&design, &file.verify);
-    let feasible = verification.as_ref().is_some_and(|a| a.ok);
+    // The optimum is confirmed by the run and verdict of `kappe design` (robot plan, its clock,
+    // the base tolerance), with the verification analysis written into the design, so that
+    // `kappe design` of the written file reaches the same verdict (issue 22).
+    let mut design = to_design(&x);
+    design.analysis = file.verify.clone();
+    let (volume, _, mut failing, _) = evaluate(&design, &file.verify);
+    let confirmation = crate::run(
+        &design,
+        &crate::run::Options::of(&design),
+        &crate::run::no_progress,
+    );
+    let (verification, verdict) = match confirmation {
+        Ok(outcome) => (outcome.analysis, Some(outcome.verdict)),
+        Err(DesignError::Cancelled) => return Err(DesignError::Cancelled),
+        Err(e) => {
+            failing.push(format!("the design cannot be run: {e}"));
+            (None, None)
+        }
+    };
+    let feasible = verdict.as_ref().is_some_and(|v| v.ok);
+    if let Some(v) = verdict.as_ref().filter(|v| !v.ok) {
+        failing = v.failures.iter().map(ToString::to_string).collect();
+    }
     let binding = match &verification {
-        Some(a) if a.ok => a
+        Some(a) if feasible => a
             .constraints
             .iter()
             .filter(|c| match c.worst {
@@ -507,6 +531,7 @@ pub fn optimize_until(
         binding,
         at_bounds,
         verification,
+        verdict,
     })
 }
 

@@ -87,7 +87,10 @@ impl TriMesh {
 
     /// Binary glTF 2.0 (one mesh, one primitive). glTF is y-up, so the mesh is rotated
     /// z-up → y-up (x, y, z) ↦ (x, z, −y) as the glTF spec asks.
-    pub fn to_glb(&self) -> Vec<u8> {
+    ///
+    /// # Errors
+    /// A mesh whose file would exceed the 4 GiB that a GLB header can state.
+    pub fn to_glb(&self) -> Result<Vec<u8>, GlbError> {
         let mut bin: Vec<u8> =
             Vec::with_capacity(self.positions.len() * 12 + self.triangles.len() * 12);
         let mut min = [f32::INFINITY; 3];
@@ -131,21 +134,34 @@ impl TriMesh {
                 {"bufferView": 1, "componentType": 5125, "count": self.triangles.len() * 3, "type": "SCALAR"}
             ]
         });
-        let mut json_bytes = serde_json::to_vec(&json).unwrap_or_default();
+        let mut json_bytes =
+            serde_json::to_vec(&json).map_err(|e| GlbError(format!("its JSON chunk: {e}")))?;
         while !json_bytes.len().is_multiple_of(4) {
             json_bytes.push(b' ');
         }
         let total = 12 + 8 + json_bytes.len() + 8 + bin.len();
+        let size = |n: usize| {
+            u32::try_from(n).map_err(|_| {
+                GlbError(format!(
+                    "{total} bytes: more than the 4 GiB a binary glTF can hold (write cap.obj)"
+                ))
+            })
+        };
         let mut out = Vec::with_capacity(total);
         out.extend_from_slice(b"glTF");
         out.extend_from_slice(&2u32.to_le_bytes());
-        out.extend_from_slice(&(total as u32).to_le_bytes());
-        out.extend_from_slice(&(json_bytes.len() as u32).to_le_bytes());
+        out.extend_from_slice(&size(total)?.to_le_bytes());
+        out.extend_from_slice(&size(json_bytes.len())?.to_le_bytes());
         out.extend_from_slice(b"JSON");
         out.extend_from_slice(&json_bytes);
-        out.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+        out.extend_from_slice(&size(bin.len())?.to_le_bytes());
         out.extend_from_slice(b"BIN\0");
         out.extend_from_slice(&bin);
-        out
+        Ok(out)
     }
 }
+
+/// Why the beads cannot be written as a binary glTF.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write cap.glb: {0}")]
+pub struct GlbError(String);

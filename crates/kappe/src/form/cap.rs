@@ -5,11 +5,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::analysis::layer_overhangs;
 use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer};
 use crate::form::beads::{TriMesh, bead_mesh};
 use crate::form::forces::{Sections2D, StateForces, state_forces};
 use crate::form::frame::LayerFrame;
+use crate::form::overhang::layer_overhangs;
 use crate::form::path::{PrintPath, print_path};
 use crate::form::section::{Sections, build_sections_with_end};
 use crate::form::states::{State, build_state};

@@ -27,7 +27,7 @@ pub struct Design {
     #[serde(skip_serializing_if = "crate::input::schedule::ScheduleSpec::is_empty")]
     pub schedule: crate::input::schedule::ScheduleSpec,
     /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
-    pub analysis: crate::analysis::AnalysisOptions,
+    pub analysis: crate::input::analysis::AnalysisOptions,
 }
 
 /// Global geometry (method.md §2).
@@ -211,7 +211,7 @@ impl Default for Design {
             constraints: ConstraintSpec::default(),
             robot: RobotSpec::default(),
             schedule: crate::input::schedule::ScheduleSpec::default(),
-            analysis: crate::analysis::AnalysisOptions::default(),
+            analysis: crate::input::analysis::AnalysisOptions::default(),
         }
     }
 }
@@ -281,8 +281,11 @@ impl Design {
     }
 
     /// Serialize to TOML (the resolved design, every field explicit).
-    pub fn to_toml_string(&self) -> String {
-        toml::to_string(self).unwrap_or_default()
+    ///
+    /// # Errors
+    /// [`DesignError::ToToml`] for a value TOML cannot hold (e.g. a non-finite number).
+    pub fn to_toml_string(&self) -> Result<String, DesignError> {
+        toml::to_string(self).map_err(|e| DesignError::ToToml(e.to_string()))
     }
 
     /// Layer tilt am in radians.

@@ -34,6 +34,10 @@ pub enum DesignError {
         /// What is wrong.
         message: String,
     },
+    /// The design cannot be written back as TOML (a value TOML cannot hold, e.g. a NaN set
+    /// from code).
+    #[error("cannot write the design as TOML: {0}")]
+    ToToml(String),
     /// The caller's progress callback asked the run to stop (e.g. Ctrl-C in Python).
     #[error("cancelled")]
     Cancelled,

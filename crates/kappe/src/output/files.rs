@@ -82,7 +82,12 @@ impl Outcome {
             json("network.json", &network)?,
             OutputFile::new("path.csv", cap.path.to_csv()),
             OutputFile::new("cap.obj", cap.mesh.to_obj(&cap.design.name)),
-            OutputFile::new("cap.glb", cap.mesh.to_glb()),
+            OutputFile::new(
+                "cap.glb",
+                cap.mesh
+                    .to_glb()
+                    .map_err(|e| OutputError::Produce(e.to_string()))?,
+            ),
             OutputFile::new("report.html", report),
         ];
         // The layer times the structural check and the robot share (issue 11).

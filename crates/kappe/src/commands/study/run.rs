@@ -29,8 +29,8 @@ pub fn parameter_values(v: &Variation, parameter_paths: &[String]) -> Vec<String
                 .or_else(|| {
                     v.design.as_ref().ok().and_then(|d| {
                         d.to_toml_string()
-                            .parse::<toml::Table>()
                             .ok()
+                            .and_then(|s| s.parse::<toml::Table>().ok())
                             .and_then(|t| get_path(&t, p).map(show))
                     })
                 })

@@ -85,7 +85,8 @@ fn mutate(doc: &mut Value, pick: usize, new: Option<Value>) {
 
 /// The design file's dotted keys, from the resolved default.
 fn design_keys() -> Vec<(String, String)> {
-    let table: toml::Table = toml::from_str(&kappe::Design::default().to_toml_string()).unwrap();
+    let table: toml::Table =
+        toml::from_str(&kappe::Design::default().to_toml_string().unwrap()).unwrap();
     let mut keys = Vec::new();
     for (section, v) in &table {
         if let toml::Value::Table(t) = v {
@@ -128,7 +129,7 @@ proptest! {
             Ok(design) => {
                 // A valid result: it round-trips through the writer.
                 prop_assert!(!unknown);
-                let again = kappe::Design::from_toml_str(&design.to_toml_string());
+                let again = kappe::Design::from_toml_str(&design.to_toml_string().unwrap());
                 prop_assert!(again.is_ok(), "{:?}", again.err());
             }
             Err(err) => {

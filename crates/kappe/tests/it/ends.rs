@@ -147,8 +147,8 @@ fn design_file_end_option() {
     assert_eq!(d.cap.end, EndKind::EndWall);
     let d0 = Design::default();
     assert_eq!(d0.cap.end, EndKind::StartSection);
-    assert!(!d0.to_toml_string().contains("end ="));
-    assert!(d.to_toml_string().contains("end = \"end_wall\""));
+    assert!(!d0.to_toml_string().unwrap().contains("end ="));
+    assert!(d.to_toml_string().unwrap().contains("end = \"end_wall\""));
     let err = Design::from_toml_str("[cap]\nend = \"wall\"\n")
         .unwrap_err()
         .to_string();

@@ -367,7 +367,7 @@ fn meshes_are_valid_gltf_and_obj() {
     let mut d = Design::default();
     d.cap.length = 0.05;
     let cap = design_cap(&d, &|_| {}).unwrap();
-    let glb = cap.mesh.to_glb();
+    let glb = cap.mesh.to_glb().unwrap();
     let gltf = gltf::Gltf::from_slice(&glb).expect("valid GLB");
     let mesh = gltf.meshes().next().unwrap();
     let prim = mesh.primitives().next().unwrap();

@@ -1,0 +1,14 @@
+//! The kappe crate's integration tests: one binary, one module per area (issue 22).
+
+mod analysis;
+mod analysis_loop;
+mod analysis_props;
+mod cap;
+mod ceiling;
+mod ends;
+mod floors;
+mod green_state;
+mod readers_fuzz;
+mod scale;
+mod shell_element;
+mod summary_schema;
