@@ -22,9 +22,8 @@ use std::ops::ControlFlow;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{Analysis, AnalysisOptions, StateSelection, analyze};
+use crate::analysis::{Analysis, AnalysisOptions, StateSelection};
 use crate::commands::calibrate_blf::DesignSource;
-use crate::form::cap::design_cap;
 use crate::input::design::Design;
 use crate::input::error::DesignError;
 
@@ -324,32 +323,60 @@ fn violations(a: &Analysis) -> Vec<(String, f64)> {
         .collect()
 }
 
-/// Evaluate one design: (volume, violation, failing names, analysis).
-fn evaluate(
-    d: &Design,
-    options: &AnalysisOptions,
-) -> (Option<f64>, f64, Vec<String>, Option<Analysis>) {
+/// What one evaluation found.
+struct Evaluated {
+    volume: Option<f64>,
+    violation: f64,
+    failing: Vec<String>,
+    analysis: Option<Analysis>,
+    verdict: Option<crate::verdict::Verdict>,
+}
+
+/// Evaluate one design with `kappe design`'s run and verdict (issue 22: the optimum must pass
+/// `kappe design`), its `[analysis]` replaced by `options`: the relative violations of the
+/// failing constraints, plus [`ROBOT_FAILURE`] for a robot plan (or base tolerance in the
+/// verdict) that fails.
+fn evaluate(d: &Design, options: &AnalysisOptions) -> Evaluated {
     // Designs the method cannot build are infeasible by a large margin, so any buildable design
     // is preferred.
     const UNBUILDABLE: f64 = 1e3;
-    if let Err(e) = d.validate() {
-        return (None, UNBUILDABLE, vec![e.to_string()], None);
-    }
-    let cap = match design_cap(d, &|_| {}) {
-        Ok(c) => c,
-        Err(e) => return (None, UNBUILDABLE, vec![e.to_string()], None),
+    let unbuildable = |e: &DesignError| Evaluated {
+        volume: None,
+        violation: UNBUILDABLE,
+        failing: vec![e.to_string()],
+        analysis: None,
+        verdict: None,
     };
-    let volume = Some(cap.path.volume);
-    match analyze(&cap, options, &|_| {}) {
-        Ok(a) => {
-            let v = violations(&a);
+    let mut d = d.clone();
+    d.analysis = options.clone();
+    if let Err(e) = d.validate() {
+        return unbuildable(&e);
+    }
+    match crate::run(&d, &crate::run::Options::of(&d), &crate::run::no_progress) {
+        Ok(out) => {
+            let mut v = out.analysis.as_ref().map(violations).unwrap_or_default();
+            for f in &out.verdict.failures {
+                if !matches!(f, crate::verdict::Failure::Constraint { .. }) {
+                    v.push((f.to_string(), ROBOT_FAILURE));
+                }
+            }
             // `+ 0.0` turns the −0.0 of an empty sum into 0.
             let total: f64 = v.iter().map(|x| x.1).sum::<f64>() + 0.0;
-            (volume, total, v.into_iter().map(|x| x.0).collect(), Some(a))
+            Evaluated {
+                volume: Some(out.cap.path.volume),
+                violation: total,
+                failing: v.into_iter().map(|x| x.0).collect(),
+                analysis: out.analysis,
+                verdict: Some(out.verdict),
+            }
         }
-        Err(e) => (volume, UNBUILDABLE, vec![e.to_string()], None),
+        Err(e) => unbuildable(&e),
     }
 }
+
+/// The violation a failing robot plan counts as: a constraint missed by 100 %, so a design the
+/// robot can print is preferred to one it cannot, but a buildable design to neither.
+const ROBOT_FAILURE: f64 = 1.0;
 
 fn better(a: (f64, Option<f64>), b: (f64, Option<f64>)) -> bool {
     const EPS: f64 = 1e-12;
@@ -411,7 +438,12 @@ pub fn optimize_until(
         if let Some(&c) = cache.get(&key(x)) {
             return c;
         }
-        let (volume, violation, failing, _) = evaluate(&to_design(x), &file.analysis);
+        let Evaluated {
+            volume,
+            violation,
+            failing,
+            ..
+        } = evaluate(&to_design(x), &file.analysis);
         let e = Evaluation {
             evaluation: evaluations.len() + 1,
             parameters: named(x),
@@ -471,25 +503,18 @@ pub fn optimize_until(
         }
     }
 
-    // The optimum is confirmed by the run and verdict of `kappe design` (robot plan, its clock,
-    // the base tolerance), with the verification analysis written into the design, so that
-    // `kappe design` of the written file reaches the same verdict (issue 22).
+    // The optimum is confirmed by the run and verdict of `kappe design` with the verification
+    // analysis, which is written into the design, so that `kappe design` of the written file
+    // reaches the same verdict (issue 22).
     let mut design = to_design(&x);
     design.analysis = file.verify.clone();
-    let (volume, _, mut failing, _) = evaluate(&design, &file.verify);
-    let confirmation = crate::run(
-        &design,
-        &crate::run::Options::of(&design),
-        &crate::run::no_progress,
-    );
-    let (verification, verdict) = match confirmation {
-        Ok(outcome) => (outcome.analysis, Some(outcome.verdict)),
-        Err(DesignError::Cancelled) => return Err(DesignError::Cancelled),
-        Err(e) => {
-            failing.push(format!("the design cannot be run: {e}"));
-            (None, None)
-        }
-    };
+    let Evaluated {
+        volume,
+        mut failing,
+        analysis: verification,
+        verdict,
+        ..
+    } = evaluate(&design, &file.verify);
     let feasible = verdict.as_ref().is_some_and(|v| v.ok);
     if let Some(v) = verdict.as_ref().filter(|v| !v.ok) {
         failing = v.failures.iter().map(ToString::to_string).collect();
