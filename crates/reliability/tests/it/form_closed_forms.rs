@@ -171,3 +171,78 @@ fn lognormal_r_minus_s_against_numerical_integration() {
     let beta_ref = -stdnormal::inv_cdf(reference);
     assert!((r.beta - beta_ref).abs() < 1e-8, "{} vs {beta_ref}", r.beta);
 }
+
+#[test]
+fn lognormal_sensitivities_against_the_differentiated_closed_form() {
+    // β(μR, σR, μS, σS) = (λR − λS)/√(ζR² + ζS²) for g = ln R − ln S; its derivatives by central
+    // differences of the closed form itself (step 1e−5 of each parameter, truncation ~1e−10).
+    let beta = |p: [f64; 4]| {
+        let (zr2, zs2) = ((p[1] / p[0]).powi(2).ln_1p(), (p[3] / p[2]).powi(2).ln_1p());
+        let (lr, ls) = (p[0].ln() - 0.5 * zr2, p[2].ln() - 0.5 * zs2);
+        (lr - ls) / (zr2 + zs2).sqrt()
+    };
+    let p0 = [200.0, 30.0, 100.0, 25.0];
+    let model = Model::independent(vec![
+        RandomVariable::lognormal("R", p0[0], p0[1]).unwrap(),
+        RandomVariable::lognormal("S", p0[2], p0[3]).unwrap(),
+    ])
+    .unwrap();
+    let r = form(
+        &model,
+        &mut |x: &[f64]| x[0].ln() - x[1].ln(),
+        &FormOptions::default(),
+    )
+    .unwrap();
+    let got = [
+        r.dbeta_dmean[0],
+        r.dbeta_dstd[0],
+        r.dbeta_dmean[1],
+        r.dbeta_dstd[1],
+    ];
+    for k in 0..4 {
+        let h = 1e-5 * p0[k];
+        let (mut up, mut dn) = (p0, p0);
+        up[k] += h;
+        dn[k] -= h;
+        let want = (beta(up) - beta(dn)) / (2.0 * h);
+        // 1e−6 relative: both sides are central differences with errors ≤ 1e−9 relative, and
+        // FORM's design point is exact here (g linear in u).
+        assert!(
+            ((got[k] - want) / want).abs() < 1e-6,
+            "k {k}: {} vs {want}",
+            got[k]
+        );
+    }
+}
+
+#[test]
+fn failing_means_give_a_negative_beta() {
+    // g = S − R fails at the means: β = −50/√500, P_f = Φ(50/√500) > ½.
+    let r = form(
+        &r_s(),
+        &mut |x: &[f64]| x[1] - x[0],
+        &FormOptions::default(),
+    )
+    .unwrap();
+    assert!((r.beta + 50.0 / 500f64.sqrt()).abs() < 1e-9);
+    assert!(r.pf > 0.5);
+}
+
+#[test]
+fn uniform_variable_threshold() {
+    // g = X − 3, X ~ U(2, 10): P_f = (3 − 2)/8 exactly, and g(x(u)) = 0 at one u, a half-line in
+    // u, so FORM is exact: β = −Φ⁻¹(1/8). g is nonlinear in u, so the iterate stops within
+    // ε_G·|G₀|/‖∇G‖ of the root: ε_G = 1e−12 makes that ~1e−12, and 1e−9 covers Φ, Φ⁻¹ round-off.
+    let model = Model::independent(vec![RandomVariable::uniform("X", 2.0, 10.0).unwrap()]).unwrap();
+    let options = FormOptions {
+        g_tolerance: 1e-12,
+        ..FormOptions::default()
+    };
+    let r = form(&model, &mut |x: &[f64]| x[0] - 3.0, &options).unwrap();
+    assert!(
+        (r.beta + stdnormal::inv_cdf(0.125)).abs() < 1e-9,
+        "{}",
+        r.beta
+    );
+    assert!((r.x_star[0] - 3.0).abs() < 1e-9);
+}
