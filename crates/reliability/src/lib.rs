@@ -47,7 +47,7 @@ pub use limit_state::{Fallible, LimitState, WithGradient};
 pub use model::{Correlation, Model};
 pub use sampling::{
     Batch, BlockSums, SamplingBatch, SamplingMethod, SamplingOptions, SamplingResult,
-    importance_sampling, merge, monte_carlo, sample_batch,
+    importance_sampling, merge, monte_carlo, sample_batch, sample_batch_parallel,
 };
 pub use system::{Component, SystemOptions, SystemResult, series_system};
 pub use variable::{Distribution, RandomVariable};

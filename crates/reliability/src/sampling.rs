@@ -22,13 +22,14 @@
 //! Σw, Σw²). [`merge`] sorts the blocks and adds them in block order; a single run is the merge
 //! of batch 0 of 1, so every split gives the same floating-point sums — the same result, bit for bit.
 
-use crate::error::{Error, Result};
-use crate::limit_state::LimitState;
+use crate::error::{Error, EvalError, Result};
+use crate::limit_state::{Fallible, LimitState};
 use crate::model::Model;
 use crate::rng;
 use crate::stdnormal;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Which estimator.
@@ -170,67 +171,121 @@ pub fn sample_batch<L: LimitState + ?Sized>(
     batch: Batch,
 ) -> Result<SamplingBatch> {
     check(model, method, options, batch)?;
-    let n = model.len();
-    let total_blocks = options.blocks();
-    let first = batch.index * total_blocks / batch.count;
-    let last = (batch.index + 1) * total_blocks / batch.count;
-    let center = match method {
-        SamplingMethod::MonteCarlo => None,
-        SamplingMethod::ImportanceSampling { center } => Some(center.as_slice()),
-    };
-    let half_c2 = center.map_or(0.0, |c| 0.5 * c.iter().map(|v| v * v).sum::<f64>());
-    let mut u = vec![0.0; n];
-    let mut blocks = Vec::with_capacity((last - first) as usize);
-    for b in first..last {
-        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-        rng.set_stream(b);
-        let count = options
-            .block_size
-            .min(options.samples - b * options.block_size);
-        let mut sums = BlockSums {
-            block: b,
-            samples: count,
-            failures: 0,
-            sum_w: 0.0,
-            sum_w2: 0.0,
-        };
-        for _ in 0..count {
-            for v in u.iter_mut() {
-                *v = rng::std_normal(&mut rng);
-            }
-            let mut w = 1.0;
-            if let Some(c) = center {
-                for (v, ci) in u.iter_mut().zip(c) {
-                    *v += ci;
-                }
-                let cu: f64 = c.iter().zip(&u).map(|(a, b)| a * b).sum();
-                w = (half_c2 - cu).exp();
-            }
-            let x = model.x_from_u(&u);
-            let g = limit_state.value(&x).map_err(|source| Error::LimitState {
-                x: x.clone(),
-                source,
-            })?;
-            if g.is_nan() {
-                return Err(Error::NonFiniteLimitState {
-                    what: "value",
-                    value: g,
-                    x,
-                });
-            }
-            if g <= 0.0 {
-                sums.failures += 1;
-                sums.sum_w += w;
-                sums.sum_w2 += w * w;
-            }
-        }
-        blocks.push(sums);
-    }
+    let (first, last) = block_range(options, batch);
+    let center = center_of(method);
+    let blocks = (first..last)
+        .map(|b| run_block(model, limit_state, center, options, b))
+        .collect::<Result<Vec<_>>>()?;
     Ok(SamplingBatch {
         method: method.clone(),
         options: options.clone(),
         blocks,
     })
+}
+
+/// Batch `batch` with its blocks run in parallel (rayon), for a limit state that can be shared
+/// between threads. Each block is still summed sequentially and the blocks are kept in order, so
+/// the result equals [`sample_batch`]'s bit for bit.
+pub fn sample_batch_parallel<F>(
+    model: &Model,
+    limit_state: &F,
+    method: &SamplingMethod,
+    options: &SamplingOptions,
+    batch: Batch,
+) -> Result<SamplingBatch>
+where
+    F: Fn(&[f64]) -> Result<f64, EvalError> + Sync,
+{
+    check(model, method, options, batch)?;
+    let (first, last) = block_range(options, batch);
+    let center = center_of(method);
+    let blocks = (first..last)
+        .into_par_iter()
+        .map(|b| {
+            run_block(
+                model,
+                &mut Fallible(|x: &[f64]| limit_state(x)),
+                center,
+                options,
+                b,
+            )
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(SamplingBatch {
+        method: method.clone(),
+        options: options.clone(),
+        blocks,
+    })
+}
+
+fn block_range(options: &SamplingOptions, batch: Batch) -> (u64, u64) {
+    let total = options.blocks();
+    (
+        batch.index * total / batch.count,
+        (batch.index + 1) * total / batch.count,
+    )
+}
+
+fn center_of(method: &SamplingMethod) -> Option<&[f64]> {
+    match method {
+        SamplingMethod::MonteCarlo => None,
+        SamplingMethod::ImportanceSampling { center } => Some(center.as_slice()),
+    }
+}
+
+/// The sums of block `b`: its own ChaCha8 stream, samples in order.
+fn run_block<L: LimitState + ?Sized>(
+    model: &Model,
+    limit_state: &mut L,
+    center: Option<&[f64]>,
+    options: &SamplingOptions,
+    b: u64,
+) -> Result<BlockSums> {
+    let half_c2 = center.map_or(0.0, |c| 0.5 * c.iter().map(|v| v * v).sum::<f64>());
+    let mut u = vec![0.0; model.len()];
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    rng.set_stream(b);
+    let count = options
+        .block_size
+        .min(options.samples - b * options.block_size);
+    let mut sums = BlockSums {
+        block: b,
+        samples: count,
+        failures: 0,
+        sum_w: 0.0,
+        sum_w2: 0.0,
+    };
+    for _ in 0..count {
+        for v in u.iter_mut() {
+            *v = rng::std_normal(&mut rng);
+        }
+        let mut w = 1.0;
+        if let Some(c) = center {
+            for (v, ci) in u.iter_mut().zip(c) {
+                *v += ci;
+            }
+            let cu: f64 = c.iter().zip(&u).map(|(a, b)| a * b).sum();
+            w = (half_c2 - cu).exp();
+        }
+        let x = model.x_from_u(&u);
+        let g = limit_state.value(&x).map_err(|source| Error::LimitState {
+            x: x.clone(),
+            source,
+        })?;
+        if g.is_nan() {
+            return Err(Error::NonFiniteLimitState {
+                what: "value",
+                value: g,
+                x,
+            });
+        }
+        if g <= 0.0 {
+            sums.failures += 1;
+            sums.sum_w += w;
+            sums.sum_w2 += w * w;
+        }
+    }
+    Ok(sums)
 }
 
 /// Merges the batches of one run (in any order) into its estimate; errors when they belong to

@@ -5,6 +5,7 @@ use crate::common::expect_normal;
 use kappe_reliability::{
     Batch, Correlation, FormOptions, Model, RandomVariable, SamplingBatch, SamplingMethod,
     SamplingOptions, form, importance_sampling, merge, monte_carlo, sample_batch,
+    sample_batch_parallel,
 };
 
 fn r_s() -> Model {
@@ -174,5 +175,46 @@ fn batches_merge_bit_for_bit_into_the_single_run() {
                 .clone()
         };
         assert_ne!(blocks(42), blocks(43));
+    }
+}
+
+#[test]
+fn parallel_blocks_equal_the_sequential_batch() {
+    let model = r_s();
+    let f = form(
+        &model,
+        &mut |x: &[f64]| x[0] - x[1],
+        &FormOptions::default(),
+    )
+    .unwrap();
+    let options = SamplingOptions {
+        block_size: 700,
+        ..SamplingOptions::new(9_000, 5)
+    };
+    for method in [
+        SamplingMethod::MonteCarlo,
+        SamplingMethod::ImportanceSampling {
+            center: f.u_star.clone(),
+        },
+    ] {
+        for batch in [Batch { index: 0, count: 1 }, Batch { index: 1, count: 3 }] {
+            let seq = sample_batch(
+                &model,
+                &mut |x: &[f64]| x[0] - x[1],
+                &method,
+                &options,
+                batch,
+            )
+            .unwrap();
+            let par = sample_batch_parallel(
+                &model,
+                &|x: &[f64]| Ok(x[0] - x[1]),
+                &method,
+                &options,
+                batch,
+            )
+            .unwrap();
+            assert_eq!(seq, par);
+        }
     }
 }
