@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 /// A step of the drift factor at a print time.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct DriftStep {
     /// Print time of the step, h.
     pub at_hours: f64,
@@ -28,6 +29,7 @@ pub struct DriftStep {
 
 /// A drift of a parameter's mean over print time; see the module docs.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Drift {
     /// Linear change in % of the base value per hour (negative: decreasing).
     pub percent_per_hour: f64,

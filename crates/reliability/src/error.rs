@@ -14,6 +14,13 @@ pub enum Error {
         value: f64,
         allowed: &'static str,
     },
+    /// An input-file spec with a missing, extra or conflicting field.
+    #[error("uncertainty of `{variable}`: field `{field}`: {allowed}")]
+    InvalidSpec {
+        variable: String,
+        field: &'static str,
+        allowed: &'static str,
+    },
     /// A quantity declared positive with a distribution that allows values ≤ 0.
     #[error(
         "variable `{variable}` is declared positive but its {distribution} distribution {reason}; \

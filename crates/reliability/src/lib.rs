@@ -6,6 +6,7 @@
 //!   to standard normal space), validated with named errors.
 //! * [`model`]: a set of variables with a physical correlation matrix, mapped to standard normal
 //!   space by the Nataf model (exact integral, solved numerically) and a Cholesky factor.
+//! * [`spec`]: the input-file form of an uncertain parameter (`{ dist = "normal", std = … }`).
 //! * [`drift`]: a parameter whose mean drifts with print time (linear %/h, steps).
 //! * [`form`]: FORM with the improved HL-RF algorithm: β, P_f = Φ(−β), the design point, α, γ,
 //!   importance factors and dβ/dμ, dβ/dσ.
@@ -36,6 +37,7 @@ pub mod limit_state;
 pub mod model;
 mod rng;
 pub mod sampling;
+pub mod spec;
 pub mod stdnormal;
 pub mod system;
 pub mod variable;
@@ -49,5 +51,6 @@ pub use sampling::{
     Batch, BlockSums, SamplingBatch, SamplingMethod, SamplingOptions, SamplingResult,
     importance_sampling, merge, monte_carlo, sample_batch, sample_batch_parallel,
 };
+pub use spec::{DistKind, UncertaintySpec};
 pub use system::{Component, SystemOptions, SystemResult, series_system};
 pub use variable::{Distribution, RandomVariable};

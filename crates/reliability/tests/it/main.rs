@@ -7,4 +7,5 @@ mod form_closed_forms;
 mod form_literature;
 mod nataf;
 mod sampling;
+mod spec;
 mod system;
