@@ -21,6 +21,7 @@
 //! R₀ = L Lᵀ (Cholesky); u = L⁻¹z are independent standard normal variables. A Cholesky pivot ≤ 0
 //! names the variable that is (numerically) a linear combination of the ones before it.
 
+use crate::drift::Drift;
 use crate::error::{Error, Result};
 use crate::variable::{Distribution, RandomVariable};
 use serde::{Deserialize, Serialize};
@@ -68,6 +69,7 @@ impl Model {
                     variable: v.name.clone(),
                 });
             }
+            v.check()?;
             v.check_positive()?;
         }
         let rho_x = physical_matrix(&variables, correlation)?;
@@ -259,6 +261,21 @@ impl Model {
             variables,
             ..self.clone()
         })
+    }
+
+    /// The model of the state printed at `t_hours`: each named variable scaled by its drift factor
+    /// c(t) ([`Drift::factor`]), the others unchanged; unknown names are an error.
+    pub fn drifted(&self, drifts: &[(String, Drift)], t_hours: f64) -> Result<Self> {
+        let mut factors = vec![1.0; self.len()];
+        for (name, drift) in drifts {
+            let i = self
+                .variables
+                .iter()
+                .position(|v| &v.name == name)
+                .ok_or_else(|| unknown(name, "the drifts", &self.variables))?;
+            factors[i] *= drift.factor(t_hours)?;
+        }
+        self.scaled(&factors)
     }
 
     pub(crate) fn distribution(&self, i: usize) -> &Distribution {

@@ -54,7 +54,9 @@ pub fn inv_cdf(p: f64) -> f64 {
         cdf(z) - p
     };
     let t = e / pdf(z);
-    z - t / (1.0 + 0.5 * z * t)
+    let refined = z - t / (1.0 + 0.5 * z * t);
+    // Past |z| ≈ 37 φ(z) underflows; keep the start there.
+    if refined.is_finite() { refined } else { z }
 }
 
 /// Reliability index of a probability, β = −Φ⁻¹(p).

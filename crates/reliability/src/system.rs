@@ -131,6 +131,24 @@ pub fn series_system(components: &[Component], options: &SystemOptions) -> Resul
     let total: f64 = p.iter().sum();
     let governing = (0..m).max_by(|&a, &b| p[a].total_cmp(&p[b])).unwrap_or(0);
     let unimodal_bounds = [p[governing], total.min(1.0)];
+    if total == 0.0 {
+        // Every pᵢ underflows (all βᵢ > ~38): nothing to sample. β_sys ≤ minᵢ βᵢ always, and
+        // that bound is reported as β.
+        let beta = components
+            .iter()
+            .map(|c| c.beta)
+            .fold(f64::INFINITY, f64::min);
+        return Ok(SystemResult {
+            pf: 0.0,
+            beta,
+            cov: 0.0,
+            interval: [0.0, 0.0],
+            samples: 0,
+            unimodal_bounds,
+            ditlevsen_bounds: options.ditlevsen.then_some([0.0, 0.0]),
+            governing,
+        });
+    }
     let mut cumulative = Vec::with_capacity(m);
     let mut acc = 0.0;
     for pi in &p {

@@ -316,6 +316,51 @@ impl RandomVariable {
         }
     }
 
+    /// Re-checks the parameters (the fields are public and deserialisable, so a variable may not
+    /// come from the validating constructors).
+    pub(crate) fn check(&self) -> Result<()> {
+        let name = self.name.as_str();
+        match self.distribution {
+            Distribution::Normal { mean, std } => {
+                check(name, "mean", mean, true, "a finite number")?;
+                check(name, "std", std, std > 0.0, "std must be finite and > 0")
+            }
+            Distribution::Lognormal {
+                mean,
+                std,
+                lambda,
+                zeta,
+            } => {
+                check(
+                    name,
+                    "mean",
+                    mean,
+                    mean > 0.0,
+                    "a lognormal mean must be finite and > 0",
+                )?;
+                check(name, "std", std, std > 0.0, "std must be finite and > 0")?;
+                check(name, "lambda", lambda, true, "a finite number")?;
+                check(
+                    name,
+                    "zeta",
+                    zeta,
+                    zeta > 0.0,
+                    "zeta must be finite and > 0",
+                )
+            }
+            Distribution::Uniform { lower, upper } => {
+                check(name, "lower", lower, true, "a finite number")?;
+                check(
+                    name,
+                    "upper",
+                    upper,
+                    upper > lower,
+                    "upper must be finite and > lower",
+                )
+            }
+        }
+    }
+
     /// Declares the quantity positive; [`crate::Model::new`] then rejects a normal distribution
     /// (unbounded below) and uniform bounds with lower ≤ 0.
     pub fn positive(mut self) -> Self {

@@ -264,3 +264,29 @@ fn bad_sampling_and_systems() {
     let e = series_system(&[c(vec![1.0, 0.0]), c(vec![1.0])], &so).unwrap_err();
     assert!(matches!(&e, Error::DimensionMismatch { .. }));
 }
+
+#[test]
+fn hand_built_variables_are_checked_and_drift_names_must_exist() {
+    let mut v = n("E");
+    v.distribution = kappe_reliability::Distribution::Normal {
+        mean: 1.0,
+        std: -2.0,
+    };
+    let e = Model::independent(vec![v]).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { variable, field: "std", .. } if variable == "E")
+    );
+    let model = Model::independent(vec![n("E"), n("q")]).unwrap();
+    let e = model
+        .drifted(&[("G".to_owned(), Drift::linear(-1.0))], 2.0)
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::UnknownVariable { name, context: "the drifts", .. } if name == "G")
+    );
+    let state = model
+        .drifted(&[("E".to_owned(), Drift::linear(-1.0))], 2.0)
+        .unwrap();
+    // c(2 h) = 0.98 on E only (closed form, round-off only).
+    assert!((state.variables()[0].distribution.mean() - 9.8).abs() < 1e-12);
+    assert_eq!(state.variables()[1].distribution.mean(), 10.0);
+}
