@@ -18,7 +18,7 @@
 //!
 //! whose integrand is bounded and smooth on the whole interval (unlike the plain Plackett
 //! integrand in r, which has a 1/√(1−r²) factor), integrated with composite 10-point
-//! Gauss–Legendre over 16 panels.
+//! Gauss–Legendre on panels of width ≤ π/32 (at most 16).
 
 use statrs::function::erf::erfc_inv;
 
@@ -92,7 +92,9 @@ pub fn bivariate_cdf(a: f64, b: f64, rho: f64) -> f64 {
         return (cdf(a) - cdf(-b)).max(0.0);
     }
     let upper = rho.asin();
-    let panels = 16;
+    // Panels of width ≤ π/32 (16 over the largest interval, π/2): the smooth integrand is then
+    // integrated to ~1e−15; short intervals (small |ρ|) take fewer panels.
+    let panels = ((upper.abs() / (std::f64::consts::PI / 32.0)).ceil() as usize).max(1);
     let h = upper / panels as f64;
     let mut sum = 0.0;
     for k in 0..panels {

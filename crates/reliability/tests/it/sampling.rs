@@ -91,7 +91,7 @@ fn importance_sampling_around_the_design_point_matches_the_reference() {
     )
     .unwrap();
     // The reference (Simpson, ~1e−13) lies in the 95 % interval of 10⁴ importance samples, whose
-    // CoV is a few % (vs ~30 % for crude MC with as many samples at this P_f).
+    // CoV is a few % (vs ~18 % for crude MC with as many samples at this P_f).
     assert!(
         is.interval[0] <= reference && reference <= is.interval[1],
         "{:?} vs {reference}",
