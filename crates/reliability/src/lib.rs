@@ -8,7 +8,7 @@
 //!   space by the Nataf model (exact integral, solved numerically) and a Cholesky factor.
 //! * [`spec`]: the input-file form of an uncertain parameter (`{ dist = "normal", std = … }`).
 //! * [`drift`]: a parameter whose mean drifts with print time (linear %/h, steps).
-//! * [`form`]: FORM with the improved HL-RF algorithm: β, P_f = Φ(−β), the design point, α, γ,
+//! * [`mod@form`]: FORM with the improved HL-RF algorithm: β, P_f = Φ(−β), the design point, α, γ,
 //!   importance factors and dβ/dμ, dβ/dσ.
 //! * [`system`]: a series system of many FORM components (every state × every check), with
 //!   ρᵢⱼ = αᵢᵀαⱼ: P_f,sys by seeded importance sampling of the union, and Ditlevsen bounds.

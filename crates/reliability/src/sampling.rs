@@ -17,7 +17,7 @@
 //! The N samples are cut into blocks of `block_size` (the last may be shorter). Block b draws from
 //! its own derived stream: `ChaCha8Rng::seed_from_u64(seed)` with `set_stream(b)` (ChaCha's 64-bit
 //! stream id; streams are independent keystreams of the same key). Each normal number takes one
-//! 64-bit word ([`crate::rng`]), so a block's samples depend only on (seed, b). Batch i of n takes
+//! 64-bit word (inverse transform, no rejection), so a block's samples depend only on (seed, b). Batch i of n takes
 //! the blocks ⌊i·B/n⌋ … ⌊(i+1)·B/n⌋ − 1 (B blocks in all) and returns per-block sums (failures,
 //! Σw, Σw²). [`merge`] sorts the blocks and adds them in block order; a single run is the merge
 //! of batch 0 of 1, so every split gives the same floating-point sums — the same result, bit for bit.
