@@ -5,8 +5,9 @@
 //! `cargo run --release -p reliability --example bench_reliability`
 
 use kappe_reliability::{
-    Component, Correlation, FormOptions, Model, RandomVariable, SamplingOptions, SystemOptions,
-    form, importance_sampling, monte_carlo, series_system,
+    Batch, Component, Correlation, FormOptions, Model, RandomVariable, SamplingMethod,
+    SamplingOptions, SystemOptions, form, importance_sampling, merge, monte_carlo,
+    sample_batch_parallel, series_system,
 };
 use std::time::Instant;
 
@@ -139,6 +140,25 @@ fn main() -> Result<(), kappe_reliability::Error> {
     println!(
         "{:<26} {:>9} {:>10.5} {:>8.4} {:>10.2} {:>12.3e}",
         "MC, 10 correlated vars",
+        100_000,
+        r.pf,
+        r.cov,
+        t * 1e3,
+        1e5 / t
+    );
+    let (t, b) = best(3, || {
+        sample_batch_parallel(
+            &ten,
+            &|x: &[f64]| Ok(g10(x)),
+            &SamplingMethod::MonteCarlo,
+            &SamplingOptions::new(100_000, 1),
+            Batch { index: 0, count: 1 },
+        )
+    });
+    let r = merge(&[b?])?;
+    println!(
+        "{:<26} {:>9} {:>10.5} {:>8.4} {:>10.2} {:>12.3e}",
+        format!("  same, rayon ({} thr.)", rayon::current_num_threads()),
         100_000,
         r.pf,
         r.cov,

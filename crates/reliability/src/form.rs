@@ -52,7 +52,7 @@ use serde::{Deserialize, Serialize};
 pub struct FormOptions {
     /// Maximum HL-RF iterations (default 100).
     pub max_iterations: usize,
-    /// ε_G: |G|/|G(start)| at convergence (default 10⁻⁶).
+    /// ε_G: |G|/|G(start)| at convergence (default 10⁻⁶; |G| itself when G(start) = 0).
     pub g_tolerance: f64,
     /// ε_u: ‖u − (αᵀu)α‖ at convergence (default 10⁻⁶).
     pub u_tolerance: f64,
