@@ -48,12 +48,17 @@ mod factor;
 pub mod generate;
 pub mod mesh_json;
 pub mod model;
+pub mod nonlinear;
 pub mod oracle;
 mod solver;
 pub mod summary;
 
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
+pub use nonlinear::{
+    Path, PathControl, PathOptions, PathStep, StopReason, deformed_resultants, nonlinear_path,
+    with_imperfection,
+};
 pub use solver::{
     BucklingOptions, BucklingResult, BucklingSolver, ElementResult, SolveStats, StaticResult,
     SturmCheck, buckling, linear_static,
