@@ -93,6 +93,33 @@ impl State {
     }
 }
 
+/// An assembled tangent `K = K_s + K_k` on the free DOFs: lower-triangle values of its
+/// symmetric part `K_s` (factorized) and of its skew part `K_k` (`K_k[j][i] = −K_k[i][j]`).
+/// With spatial spins the co-rotational tangent is not symmetric: element by element away
+/// from equilibrium, and at equilibrium wherever a fixed moment is applied (a fixed-axis
+/// moment is not conservative for three-dimensional rotations; Argyris 1982).
+pub(crate) struct Tangent {
+    pub(crate) sym: Vec<f64>,
+    pub(crate) skew: Vec<f64>,
+}
+
+impl Tangent {
+    /// `y = (K_s + K_k) x`.
+    pub(crate) fn matvec(&self, p: &Pattern, x: &[f64], y: &mut [f64]) {
+        p.sym_matvec(&self.sym, x, y);
+        for j in 0..p.n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                let a = self.skew[k];
+                if i != j && a != 0.0 {
+                    y[i] += a * x[j];
+                    y[j] -= a * x[i];
+                }
+            }
+        }
+    }
+}
+
 /// The discretised problem: DOF numbering, pattern, symbolic factorization, elements, load.
 pub(crate) struct Problem<'m> {
     pub(crate) model: &'m ShellModel,
@@ -170,29 +197,36 @@ impl<'m> Problem<'m> {
         })
     }
 
-    /// Internal force on the free DOFs and, if asked, the lower values of the symmetrised
-    /// tangent.
+    /// Internal force on the free DOFs and, if asked, the tangent: lower values of its
+    /// symmetric part and of its skew part.
     pub(crate) fn evaluate(
         &self,
         st: &State,
         tangent: bool,
-    ) -> Result<(Vec<f64>, Option<Vec<f64>>), FeError> {
+    ) -> Result<(Vec<f64>, Option<Tangent>), FeError> {
         let model = self.model;
         let mut fg = vec![0.0; 6 * model.nodes.len()];
-        let mut kv = tangent.then(|| vec![0.0; self.pattern.nnz()]);
+        let mut kv = tangent.then(|| Tangent {
+            sym: vec![0.0; self.pattern.nnz()],
+            skew: vec![0.0; self.pattern.nnz()],
+        });
         const CHUNK: usize = 2048;
         let n_el = model.triangles.len();
         let mut start = 0;
         while start < n_el {
             let end = (start + CHUNK).min(n_el);
-            let out: Vec<(Vec18, Option<crate::element::Mat18>)> = (start..end)
+            type Pair = (crate::element::Mat18, crate::element::Mat18);
+            let out: Vec<(Vec18, Option<Pair>)> = (start..end)
                 .into_par_iter()
                 .map(|e| {
                     let t = &model.triangles[e];
                     let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
                     let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
                     let (f, k) = self.elements[e].force_tangent(&x, &r, tangent);
-                    (f, k.map(|k| (k + k.transpose()) * 0.5))
+                    (
+                        f,
+                        k.map(|k| ((k + k.transpose()) * 0.5, (k - k.transpose()) * 0.5)),
+                    )
                 })
                 .collect();
             for (e, (f, k)) in (start..end).zip(out) {
@@ -202,8 +236,9 @@ impl<'m> Problem<'m> {
                         fg[6 * n + d] += f[6 * a + d];
                     }
                 }
-                if let (Some(k), Some(vals)) = (k, kv.as_mut()) {
-                    scatter(model, &self.dofs, &self.pattern, e, &k, vals)?;
+                if let (Some((ks, kk)), Some(tg)) = (k, kv.as_mut()) {
+                    scatter(model, &self.dofs, &self.pattern, e, &ks, &mut tg.sym)?;
+                    scatter(model, &self.dofs, &self.pattern, e, &kk, &mut tg.skew)?;
                 }
             }
             start = end;
@@ -328,4 +363,83 @@ pub fn deformed_resultants(
             }
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Material, NodalLoad, Support};
+
+    /// Assembled tangent against a directional central difference of the assembled internal
+    /// force, on a bent and twisted strip.
+    #[test]
+    fn assembled_tangent_matches_directional_derivative() {
+        let n = 6;
+        let mut nodes = Vec::new();
+        for i in 0..=n {
+            for j in 0..2 {
+                nodes.push([i as f64 / n as f64, 0.05 * j as f64, 0.0]);
+            }
+        }
+        let mut tris = Vec::new();
+        for i in 0..n {
+            let a = 2 * i;
+            tris.push([a, a + 2, a + 3]);
+            tris.push([a, a + 3, a + 1]);
+        }
+        let mat = Material {
+            youngs_modulus: 1e7,
+            poisson_ratio: 0.0,
+            unit_weight: 0.0,
+        };
+        let mut m = ShellModel::new(nodes, tris, 0.01, mat);
+        m.gravity = [0.0; 3];
+        m.supports = vec![Support::clamped(0), Support::clamped(1)];
+        m.nodal_loads = vec![NodalLoad {
+            node: 2 * n,
+            force: [0.0; 3],
+            moment: [0.0, -1.0, 0.0],
+        }];
+        let p = Problem::new(&m, None).unwrap();
+        let nf = p.dofs.n_free();
+        let mut st = State::initial(&m);
+        // A large bending rotation: each node i rotated by −θ·x about y, placed on the arc.
+        let th = 2.0;
+        for (k, x) in m.nodes.iter().enumerate() {
+            let a = th * x[0];
+            st.x[k] = Vector3::new(a.sin() / th, x[1], (1.0 - a.cos()) / th);
+            st.r[k] = rot_exp(&Vector3::new(0.0, -a, 0.0));
+        }
+        let dir: Vec<f64> = (0..nf)
+            .map(|i| ((i * 37 % 11) as f64 - 5.0) * 1e-1)
+            .collect();
+        let (_, kv) = p.evaluate(&st, true).unwrap();
+        let mut kd = vec![0.0; nf];
+        kv.unwrap().matvec(&p.pattern, &dir, &mut kd);
+        let h = 1e-6;
+        let fplus = {
+            let mut s = st.clone();
+            p.apply(&mut s, &dir.iter().map(|v| v * h).collect::<Vec<_>>());
+            p.evaluate(&s, false).unwrap().0
+        };
+        let fminus = {
+            let mut s = st.clone();
+            p.apply(&mut s, &dir.iter().map(|v| -v * h).collect::<Vec<_>>());
+            p.evaluate(&s, false).unwrap().0
+        };
+        let fd: Vec<f64> = fplus
+            .iter()
+            .zip(&fminus)
+            .map(|(a, b)| (a - b) / (2.0 * h))
+            .collect();
+        let scale = fd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let err = kd
+            .iter()
+            .zip(&fd)
+            .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()))
+            / scale;
+        // Central differences with h = 1e-6 on O(1) displacements: ~1e-9; the only other
+        // mismatch is the dropped O(strain · force) term of the element tangent.
+        assert!(err < 1e-6, "assembled tangent error {err:e}");
+    }
 }

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use faer::Mat;
 
-use super::{Problem, State};
+use super::{Problem, State, Tangent};
 use crate::error::FeError;
 use crate::factor::Ldlt;
 use crate::model::ShellModel;
@@ -33,8 +33,14 @@ pub struct PathOptions {
     /// Smallest step (arc length or Δλ) relative to the first; below it the path stops with
     /// [`StopReason::StepTooSmall`] (default 1e-4).
     pub min_step_ratio: f64,
-    /// Largest step relative to the first (default 4).
+    /// Largest load-factor increment of a step (arc length: of its predictor) relative to
+    /// the first (default 10).
     pub max_step_ratio: f64,
+    /// Largest arc length (m; W-norm of a step's displacement increment). `None` (default):
+    /// 5 % of the model's bounding-box diagonal. The first arc length follows from
+    /// `initial_increment` and is usually far smaller: a stiff pre-buckling state moves
+    /// little, the post-buckling path a lot; steps grow by up to 2× per step.
+    pub max_arc_length: Option<f64>,
     /// Iterations per step the step-size control aims at (default 4).
     pub target_iterations: usize,
     /// Iterations before a step is cut (default 20).
@@ -60,7 +66,8 @@ impl Default for PathOptions {
             control: PathControl::ArcLength,
             initial_increment: 0.1,
             min_step_ratio: 1e-4,
-            max_step_ratio: 4.0,
+            max_step_ratio: 10.0,
+            max_arc_length: None,
             target_iterations: 4,
             max_iterations: 20,
             max_steps: 200,
@@ -123,6 +130,9 @@ impl PathOptions {
                     allowed: "≥ 1",
                 });
             }
+        }
+        if let Some(l) = self.max_arc_length {
+            pos("max_arc_length", l, "> 0 m")?;
         }
         if let Some(l) = self.rotation_length {
             pos("rotation_length", l, "> 0 m")?;
@@ -254,6 +264,77 @@ fn norm(a: &[f64]) -> f64 {
     a.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
+/// Solve `(K_s + K_k) x = b` by GMRES (Saad & Schultz 1986), right-preconditioned with the
+/// LDLᵀ of the symmetric part `K_s`. Without a skew part the first Krylov step is exact;
+/// at equilibrium the skew part is of low rank (the nodes carrying moments), so a few steps
+/// suffice. Stops at a relative residual of 1e-12 or after 40 steps.
+fn solve_t(f: &Ldlt<'_>, k: &Tangent, p: &Problem<'_>, b: &[f64]) -> Result<Vec<f64>, FeError> {
+    const M: usize = 40;
+    let n = b.len();
+    let bn = norm(b);
+    if bn == 0.0 {
+        return Ok(vec![0.0; n]);
+    }
+    let mut v: Vec<Vec<f64>> = vec![b.iter().map(|x| x / bn).collect()];
+    let mut z: Vec<Vec<f64>> = Vec::new();
+    let mut h: Vec<Vec<f64>> = Vec::new(); // columns of the Hessenberg matrix
+    let (mut cs, mut sn): (Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new());
+    let mut g = vec![bn];
+    let mut w = vec![0.0; n];
+    for j in 0..M {
+        let zj = solve(f, &v[j])?;
+        k.matvec(&p.pattern, &zj, &mut w);
+        z.push(zj);
+        let mut col = Vec::with_capacity(j + 2);
+        for vi in &v {
+            let hij: f64 = vi.iter().zip(&w).map(|(a, b)| a * b).sum();
+            w.iter_mut().zip(vi).for_each(|(a, b)| *a -= hij * b);
+            col.push(hij);
+        }
+        let hn = norm(&w);
+        col.push(hn);
+        for i in 0..j {
+            let (a, b2) = (col[i], col[i + 1]);
+            col[i] = cs[i] * a + sn[i] * b2;
+            col[i + 1] = -sn[i] * a + cs[i] * b2;
+        }
+        let (a, b2) = (col[j], col[j + 1]);
+        let r = a.hypot(b2);
+        let (c, s) = if r == 0.0 {
+            (1.0, 0.0)
+        } else {
+            (a / r, b2 / r)
+        };
+        cs.push(c);
+        sn.push(s);
+        col[j] = r;
+        col[j + 1] = 0.0;
+        g.push(-s * g[j]);
+        g[j] *= c;
+        h.push(col);
+        let done = g[j + 1].abs() <= 1e-12 * bn || hn == 0.0;
+        if done || j + 1 == M {
+            break;
+        }
+        v.push(w.iter().map(|x| x / hn).collect());
+    }
+    // Back substitution H y = g.
+    let m = h.len();
+    let mut y = vec![0.0; m];
+    for i in (0..m).rev() {
+        let mut acc = g[i];
+        for jj in i + 1..m {
+            acc -= h[jj][i] * y[jj];
+        }
+        y[i] = if h[i][i] != 0.0 { acc / h[i][i] } else { 0.0 };
+    }
+    let mut x = vec![0.0; n];
+    for (yj, zj) in y.iter().zip(&z) {
+        x.iter_mut().zip(zj).for_each(|(a, b)| *a += yj * b);
+    }
+    Ok(x)
+}
+
 fn solve(f: &Ldlt<'_>, rhs: &[f64]) -> Result<Vec<f64>, FeError> {
     let mut m = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
     f.solve_in_place(m.as_mut())?;
@@ -262,7 +343,7 @@ fn solve(f: &Ldlt<'_>, rhs: &[f64]) -> Result<Vec<f64>, FeError> {
 
 /// Eigenvalue of the tangent closest to zero, by a few steps of inverse iteration with its
 /// factor (Rayleigh quotient of the last iterate).
-fn eig_near_zero(f: &Ldlt<'_>, kv: &[f64], p: &Problem<'_>) -> Result<f64, FeError> {
+fn eig_near_zero(f: &Ldlt<'_>, kv: &Tangent, p: &Problem<'_>) -> Result<f64, FeError> {
     let n = p.q.len();
     let mut x: Vec<f64> = (0..n)
         .map(|i| 1.0 + ((i * 7919) % 101) as f64 / 101.0)
@@ -275,7 +356,7 @@ fn eig_near_zero(f: &Ldlt<'_>, kv: &[f64], p: &Problem<'_>) -> Result<f64, FeErr
     }
     let nx = norm(&x);
     x.iter_mut().for_each(|v| *v /= nx);
-    p.pattern.sym_matvec(kv, &x, &mut y);
+    p.pattern.sym_matvec(&kv.sym, &x, &mut y);
     Ok(x.iter().zip(&y).map(|(a, b)| a * b).sum())
 }
 
@@ -284,7 +365,7 @@ struct Converged<'a> {
     lambda: f64,
     du: Vec<f64>,
     factor: Ldlt<'a>,
-    kvals: Vec<f64>,
+    kvals: Tangent,
     residual: f64,
     iterations: usize,
 }
@@ -297,15 +378,15 @@ struct Solver<'a, 'm> {
 }
 
 impl<'a, 'm> Solver<'a, 'm> {
-    fn factor(&mut self, kv: &[f64]) -> Result<Option<Ldlt<'a>>, FeError> {
+    fn factor(&mut self, kv: &Tangent) -> Result<Option<Ldlt<'a>>, FeError> {
         let t = Instant::now();
-        let f = self.p.symbolic.ldlt(&self.p.pattern, kv)?;
+        let f = self.p.symbolic.ldlt(&self.p.pattern, &kv.sym)?;
         self.stats.factorizations += 1;
         self.stats.t_factor += t.elapsed().as_secs_f64();
         Ok(f)
     }
 
-    fn evaluate(&mut self, st: &State) -> Result<(Vec<f64>, Vec<f64>), FeError> {
+    fn evaluate(&mut self, st: &State) -> Result<(Vec<f64>, Tangent), FeError> {
         let t = Instant::now();
         let (f, k) = self.p.evaluate(st, true)?;
         self.stats.assemblies += 1;
@@ -337,20 +418,25 @@ impl<'a, 'm> Solver<'a, 'm> {
         from: &State,
         lambda0: f64,
         factor0: &Ldlt<'_>,
+        k0: &Tangent,
         control: StepControl<'_>,
     ) -> Result<Option<Converged<'a>>, FeError> {
         let p = self.p;
-        let ut = solve(factor0, &p.q)?;
+        let ut = solve_t(factor0, k0, p, &p.q)?;
         let mut st = from.clone();
         let mut lambda = lambda0;
         let mut du_step: Vec<f64>;
+        let mut arc_eff = 0.0;
         match control {
             StepControl::Load(dl) => {
                 du_step = ut.iter().map(|v| v * dl).collect();
                 lambda += dl;
             }
-            StepControl::Arc { dl, prev } => {
+            StepControl::Arc { dl, prev, dlam_max } => {
                 let nut = dot_w(&p.weight, &ut, &ut).sqrt();
+                // Cap the predicted load increment (stiff pre-buckling states).
+                let dl = dl.min(dlam_max * nut);
+                arc_eff = dl;
                 let sign = match prev {
                     Some(prev) if dot_w(&p.weight, &ut, prev) < 0.0 => -1.0,
                     _ => 1.0,
@@ -385,11 +471,12 @@ impl<'a, 'm> Solver<'a, 'm> {
                 break;
             }
             let t = Instant::now();
-            let dur = solve(&factor, &r)?;
+            let dur = solve_t(&factor, &kv, p, &r)?;
             let du = match control {
                 StepControl::Load(_) => dur,
-                StepControl::Arc { dl, .. } => {
-                    let dut = solve(&factor, &p.q)?;
+                StepControl::Arc { .. } => {
+                    let dl = arc_eff;
+                    let dut = solve_t(&factor, &kv, p, &p.q)?;
                     let w = &p.weight;
                     let base: Vec<f64> = du_step.iter().zip(&dur).map(|(a, b)| a + b).collect();
                     let a = dot_w(w, &dut, &dut);
@@ -438,8 +525,15 @@ impl<'a, 'm> Solver<'a, 'm> {
 #[derive(Clone, Copy)]
 enum StepControl<'v> {
     Load(f64),
-    Arc { dl: f64, prev: Option<&'v [f64]> },
+    Arc {
+        dl: f64,
+        prev: Option<&'v [f64]>,
+        dlam_max: f64,
+    },
 }
+
+/// Relative λ-width to which a step crossing a change of the tangent's inertia is shortened.
+const LOCATE: f64 = 1e-3;
 
 /// Trace the equilibrium path of `model` under `λ ×` its reference load (self-weight ·
 /// gravity + nodal loads), geometrically nonlinear (co-rotational, small strains), from
@@ -483,17 +577,22 @@ pub fn nonlinear_path(
     let mut kvals = kv0;
     let mut neg = factor.negative;
     let mut lambda = 0.0;
-    let ut0 = solve(&factor, &problem.q)?;
+    let ut0 = solve_t(&factor, &kvals, &problem, &problem.q)?;
     let arc = options.control == PathControl::ArcLength;
     let step0 = if arc {
         options.initial_increment * dot_w(&problem.weight, &ut0, &ut0).sqrt()
     } else {
         options.initial_increment
     };
-    let (smin, smax) = (
-        step0 * options.min_step_ratio,
-        step0 * options.max_step_ratio,
-    );
+    let smin = step0 * options.min_step_ratio;
+    let smax = if arc {
+        options
+            .max_arc_length
+            .unwrap_or(0.05 * bbox_diagonal(model))
+    } else {
+        step0 * options.max_step_ratio
+    }
+    .max(step0);
     let mut size = step0;
     let mut prev: Option<Vec<f64>> = None;
     let mut steps: Vec<PathStep> = Vec::new();
@@ -514,16 +613,29 @@ pub fn nonlinear_path(
                 StepControl::Arc {
                     dl: size,
                     prev: prev.as_deref(),
+                    dlam_max: options.max_step_ratio * options.initial_increment,
                 }
             } else if to_max {
                 StepControl::Load(options.lambda_max - lambda)
             } else {
                 StepControl::Load(size.min(options.lambda_max - lambda))
             };
-            match solver.step(&state, lambda, &factor, ctrl)? {
+            match solver.step(&state, lambda, &factor, &kvals, ctrl)? {
                 Some(c) if arc && !to_max && c.lambda > options.lambda_max => {
                     // Overshot λ_max: redo the step load-controlled to λ_max exactly.
                     to_max = true;
+                }
+                Some(c)
+                    if arc
+                        && c.factor.negative != neg
+                        && (c.lambda - lambda).abs()
+                            > LOCATE * lambda.abs().max(options.initial_increment)
+                        && 0.5 * size >= smin =>
+                {
+                    // The tangent's inertia changed within a long step: shorten it until the
+                    // critical point is bracketed within LOCATE in λ.
+                    solver.stats.cut_steps += 1;
+                    size *= 0.5;
                 }
                 Some(c) => break Some(c),
                 None => {
@@ -634,13 +746,25 @@ pub fn nonlinear_path(
     })
 }
 
+fn bbox_diagonal(model: &ShellModel) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &model.nodes {
+        for c in 0..3 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt()
+}
+
 /// Maximum of the parabola through (s_i, l_i), if it is concave and its vertex lies within
 /// [s0, s2].
 fn parabola_max(s0: f64, s1: f64, s2: f64, l0: f64, l1: f64, l2: f64) -> Option<f64> {
     let d01 = (l1 - l0) / (s1 - s0);
     let d12 = (l2 - l1) / (s2 - s1);
     let a = (d12 - d01) / (s2 - s0);
-    if !(a < 0.0) {
+    if a.is_nan() || a >= 0.0 {
         return None;
     }
     let b = d01 - a * (s0 + s1);
