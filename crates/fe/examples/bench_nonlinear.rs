@@ -31,7 +31,8 @@ fn row(name: &str, model: &ShellModel, w0: f64) -> Result<(), FeError> {
     let lam = lba.factors[0];
     let imperfect = with_imperfection(model, &lba.modes[0], w0)?;
     let opt = PathOptions {
-        initial_increment: 0.2 * lam,
+        initial_increment: 0.5 * lam,
+        target_iterations: 5,
         lambda_max: 2.0 * lam,
         ..Default::default()
     };

@@ -141,6 +141,50 @@ fn l_matrix(theta: &Vector3<f64>, m: &Vector3<f64>) -> Matrix3<f64> {
         + (s * s * m) * theta.transpose() * mu
 }
 
+/// `X P = X − X A − (X S) G` (A averages the three nodes' translations).
+fn right_p<const R: usize>(
+    x: &SMatrix<f64, R, 18>,
+    s: &SMatrix<f64, 18, 3>,
+    g: &SMatrix<f64, 3, 18>,
+) -> SMatrix<f64, R, 18> {
+    let mut out = x - (x * s) * g;
+    for r in 0..R {
+        for i in 0..3 {
+            let m = (x[(r, i)] + x[(r, 6 + i)] + x[(r, 12 + i)]) / 3.0;
+            for b in 0..3 {
+                out[(r, 6 * b + i)] -= m;
+            }
+        }
+    }
+    out
+}
+
+/// `Pᵀ X = X − A X − Gᵀ (Sᵀ X)` (A is symmetric).
+fn left_pt(x: &Mat18, s: &SMatrix<f64, 18, 3>, g: &SMatrix<f64, 3, 18>) -> Mat18 {
+    let mut out = x - g.transpose() * (s.transpose() * x);
+    for c in 0..18 {
+        for i in 0..3 {
+            let m = (x[(i, c)] + x[(6 + i, c)] + x[(12 + i, c)]) / 3.0;
+            for b in 0..3 {
+                out[(6 * b + i, c)] -= m;
+            }
+        }
+    }
+    out
+}
+
+/// `Pᵀ z` for a vector.
+fn left_pt_vec(z: &Vec18, s: &SMatrix<f64, 18, 3>, g: &SMatrix<f64, 3, 18>) -> Vec18 {
+    let mut out = z - g.transpose() * (s.transpose() * z);
+    for i in 0..3 {
+        let m = (z[i] + z[6 + i] + z[12 + i]) / 3.0;
+        for b in 0..3 {
+            out[6 * b + i] -= m;
+        }
+    }
+    out
+}
+
 /// Frame rows (e₁, e₂, e₃) of the triangle `p`, as in [`TriangleGeometry::new`].
 pub(crate) fn frame_of(p: &[Vector3<f64>; 3]) -> Matrix3<f64> {
     let d2 = p[1] - p[0];
@@ -269,15 +313,9 @@ impl CrElement {
             s.fixed_view_mut::<3, 3>(6 * a + 3, 0)
                 .copy_from(&Matrix3::identity());
         }
-        let mut p = Mat18::identity() - s * g;
-        for a in 0..3 {
-            for b in 0..3 {
-                for i in 0..3 {
-                    p[(6 * a + i, 6 * b + i)] -= 1.0 / 3.0;
-                }
-            }
-        }
-        let y = p.transpose() * z;
+        // P = I − A − S G is applied, never formed: A averages the translations (rank 3),
+        // S G is rank 3 — about half the flops of dense 18×18 products.
+        let y = left_pt_vec(&z, &s, &g);
         let mut f = Vec18::zeros();
         for blk in 0..6 {
             let v = Vector3::new(y[3 * blk], y[3 * blk + 1], y[3 * blk + 2]);
@@ -289,14 +327,29 @@ impl CrElement {
         if !tangent {
             return (f, None);
         }
-        // B = H P
-        let mut bm = p;
+        // K̄ H (H mixes the rotation columns), then C = K̄ H P.
+        let mut kh = self.kbar;
         for a in 0..3 {
-            let rows = p.fixed_view::<3, 18>(6 * a + 3, 0).into_owned();
-            bm.fixed_view_mut::<3, 18>(6 * a + 3, 0)
-                .copy_from(&(hs[a] * rows));
+            let cols = self.kbar.fixed_view::<18, 3>(0, 6 * a + 3).into_owned();
+            kh.fixed_view_mut::<18, 3>(0, 6 * a + 3)
+                .copy_from(&(cols * hs[a]));
         }
-        let mut kl = bm.transpose() * (self.kbar * bm);
+        let c = right_p(&kh, &s, &g);
+        // X = Hᵀ C + L H P (both only change or fill the rotation rows), K = Pᵀ X + …
+        let mut x = c;
+        for a in 0..3 {
+            let rows = c.fixed_view::<3, 18>(6 * a + 3, 0).into_owned();
+            let m = Vector3::new(fbar[6 * a + 3], fbar[6 * a + 4], fbar[6 * a + 5]);
+            let la = l_matrix(&theta[a], &m);
+            // Rotation rows of P: E_a − G (S's rotation blocks are I).
+            let mut pa = -g;
+            for i in 0..3 {
+                pa[(i, 6 * a + 3 + i)] += 1.0;
+            }
+            x.fixed_view_mut::<3, 18>(6 * a + 3, 0)
+                .copy_from(&(hs[a].transpose() * rows + la * hs[a] * pa));
+        }
+        let mut kl = left_pt(&x, &s, &g);
         // K_GR = −F(y) G
         let mut fy = SMatrix::<f64, 18, 3>::zeros();
         for blk in 0..6 {
@@ -310,17 +363,7 @@ impl CrElement {
             let n = Vector3::new(fbar[6 * a], fbar[6 * a + 1], fbar[6 * a + 2]);
             fnm.fixed_view_mut::<3, 3>(0, 6 * a).copy_from(&spin(&n));
         }
-        kl += g.transpose() * (fnm * p);
-        // K_GM = Pᵀ L H P
-        let mut lb = Mat18::zeros();
-        for a in 0..3 {
-            let m = Vector3::new(fbar[6 * a + 3], fbar[6 * a + 4], fbar[6 * a + 5]);
-            let la = l_matrix(&theta[a], &m);
-            let rows = bm.fixed_view::<3, 18>(6 * a + 3, 0).into_owned();
-            lb.fixed_view_mut::<3, 18>(6 * a + 3, 0)
-                .copy_from(&(la * rows));
-        }
-        kl += p.transpose() * lb;
+        kl += g.transpose() * right_p(&fnm, &s, &g);
         let frame: [[f64; 3]; 3] =
             std::array::from_fn(|i| [k.tn[(i, 0)], k.tn[(i, 1)], k.tn[(i, 2)]]);
         (f, Some(to_global(&kl, &frame)))

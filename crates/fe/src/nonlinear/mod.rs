@@ -5,7 +5,11 @@
 //! * [`corotational`]: the element-independent co-rotational (EICR) wrapper of the linear
 //!   facet elements of [`crate::element`] — small strains, large rotations. Internal force
 //!   `f = Tᵀ Pᵀ Hᵀ K̄ d̄` and its consistent tangent (material + rotational, projector and
-//!   moment-correction geometric terms), assembled symmetrised.
+//!   moment-correction geometric terms; one term of order strain × force dropped). With
+//!   spatial spins this tangent is unsymmetric (element by element away from equilibrium,
+//!   and at equilibrium under fixed moments, which are not conservative for 3-D
+//!   rotations): its symmetric part is factorized (LDLᵀ, faer) and the unsymmetric system
+//!   solved by GMRES preconditioned with that factor (one or two steps without moments).
 //! * [`nonlinear_path`] traces `f_int(u) = λ q` (q: the model's reference load, self-weight
 //!   plus nodal loads, as in [`crate::buckling`]) with the arc-length constraint of Crisfield
 //!   (1981), cylindrical form `‖Δu‖²_W = Δl²` (no load term, ψ = 0), `W` weighting rotations
@@ -15,7 +19,9 @@
 //!   (`a = ‖δu_t‖²_W`, `b = 2⟨Δu + δu_r, δu_t⟩_W`, `c = ‖Δu + δu_r‖²_W − Δl²`) closest in
 //!   direction to the step so far. The predictor's sign follows the previous step
 //!   (`sign⟨δu_t, Δu_prev⟩_W`, Feng et al. 1996), which turns at limit points and snap-backs.
-//!   Step length: `Δl ← Δl·clamp(√(n_target/n_iter), ½, 2)`, halved on failure.
+//!   Step length: `Δl ← Δl·clamp(√(n_target/n_iter), ½, 2)`, halved on failure, and halved
+//!   while a step across which the tangent's inertia changes is longer than 10⁻³ in λ
+//!   (so critical points are bracketed closely).
 //! * Limit points: a step whose λ drops after a rise is past a load maximum; the maximum is
 //!   refined by a parabola through the three steps around it in the path's arc length. The
 //!   LDLᵀ of every converged tangent also gives its inertia (number of negative pivots =
@@ -23,6 +29,9 @@
 //!   bifurcation (the perfect structure's path crosses a critical point).
 //! * [`with_imperfection`] adds a scaled mode (e.g. of [`crate::buckling`]) to the nodes;
 //!   [`deformed_resultants`] gives membrane forces, moments and stresses of a path state.
+//!
+//! Verification and speed: `docs/nonlinear.md`, `tests/it/nonlinear.rs`,
+//! `examples/bench_nonlinear.rs`.
 //!
 //! Hand-written: no Rust crate provides co-rotational shells or arc-length continuation.
 //! The sparse pattern, the symbolic factorization (AMD) and faer's numeric LDLᵀ are those of
