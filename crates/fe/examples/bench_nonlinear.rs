@@ -8,6 +8,7 @@
 //! state — and the hinged roof of Sze et al. (quarter, t = 6.35 mm, central point load).
 //! Target: the collapse factor (path up to the first limit point) ≤ 10× the linear
 //! buckling solve (symbolic + assembly + static + K_G + Lanczos + Sturm check, 1 mode).
+//! Times are the best of three runs each.
 
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -18,16 +19,28 @@ use kappe_fe::{
     with_imperfection,
 };
 
+/// Best of `REPEAT` runs of each solve: the machine is shared, and the minimum is the
+/// least disturbed measurement of the same work.
+const REPEAT: usize = 3;
+
 fn row(name: &str, model: &ShellModel, w0: f64) -> Result<(), FeError> {
-    let t0 = Instant::now();
-    let lba = buckling(
-        model,
-        &BucklingOptions {
-            modes: 1,
-            ..Default::default()
-        },
-    )?;
-    let t_lba = t0.elapsed().as_secs_f64();
+    let mut t_lba = f64::INFINITY;
+    let mut lba = None;
+    for _ in 0..REPEAT {
+        let t0 = Instant::now();
+        let r = buckling(
+            model,
+            &BucklingOptions {
+                modes: 1,
+                ..Default::default()
+            },
+        )?;
+        t_lba = t_lba.min(t0.elapsed().as_secs_f64());
+        lba = Some(r);
+    }
+    let Some(lba) = lba else {
+        return Ok(());
+    };
     let lam = lba.factors[0];
     let imperfect = with_imperfection(model, &lba.modes[0], w0)?;
     let opt = PathOptions {
@@ -36,22 +49,34 @@ fn row(name: &str, model: &ShellModel, w0: f64) -> Result<(), FeError> {
         lambda_max: 2.0 * lam,
         ..Default::default()
     };
-    let t1 = Instant::now();
-    let path = nonlinear_path(&imperfect, &opt, &mut |_| ControlFlow::Continue(()))?;
-    let t_path = t1.elapsed().as_secs_f64();
+    let mut t_path = f64::INFINITY;
+    let mut best = None;
+    for _ in 0..REPEAT {
+        let t1 = Instant::now();
+        let path = nonlinear_path(&imperfect, &opt, &mut |_| ControlFlow::Continue(()))?;
+        let t = t1.elapsed().as_secs_f64();
+        if t < t_path {
+            t_path = t;
+            best = Some(path);
+        }
+    }
+    let Some(path) = best else {
+        return Ok(());
+    };
     let (collapse, kind) = match path.limit {
         Some(l) => (l.lambda, format!("{:?}", l.kind)),
         None => (f64::NAN, format!("none ({:?})", path.stop)),
     };
     let s = path.stats;
     println!(
-        "| {name} | {} | {} | {:.4} | {:.3} | {:.4} ({kind}) | {} | {} | {} | {:.3} / {:.3} | {:.3} | **{:.1}×** |",
+        "| {name} | {} | {} | {:.4} | {:.3} | {:.4} ({kind}) | {} | {} | {} | {} | {:.3} / {:.3} | {:.3} | **{:.1}×** |",
         model.nodes.len(),
         s.n_free_dofs,
         lam,
         t_lba,
         collapse,
         path.steps.len(),
+        s.cut_steps,
         s.assemblies,
         s.factorizations,
         s.t_assembly,
@@ -120,9 +145,9 @@ fn roof(n: usize) -> ShellModel {
 
 fn main() -> Result<(), FeError> {
     println!(
-        "| case | nodes | free DOFs | λ_LBA | t_LBA (s) | λ_collapse | steps | assemblies | LDLᵀ | t_asm / t_fact (s) | t_path (s) | path / LBA |"
+        "| case | nodes | free DOFs | λ_LBA | t_LBA (s) | λ_collapse | steps | cut steps | assemblies | LDLᵀ | t_asm / t_fact (s) | t_path (s) | path / LBA |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (na, nl) in [(24, 16), (40, 24), (64, 40)] {
         let m = barrel_vault(na, nl);
         row(&format!("vault {na}×{nl}, w0 = t/10"), &m, 0.002)?;

@@ -140,6 +140,9 @@ pub(crate) struct Problem<'m> {
     pub(crate) q: Vec<f64>,
     /// Arc-length weight per free DOF (1 on translations, ℓ² on rotations).
     pub(crate) weight: Vec<f64>,
+    /// Some applied moment is non-zero: the tangent's skew part then persists at
+    /// equilibrium and the corrections use GMRES on the full tangent.
+    pub(crate) has_moments: bool,
 }
 
 fn co_rotational_elements(model: &ShellModel) -> Vec<CrElement> {
@@ -203,6 +206,10 @@ impl<'m> Problem<'m> {
             elements: co_rotational_elements(model),
             q,
             weight,
+            has_moments: model
+                .nodal_loads
+                .iter()
+                .any(|l| l.moment.iter().any(|m| *m != 0.0)),
         })
     }
 

@@ -342,6 +342,17 @@ fn solve_t(
     Ok((x, ok))
 }
 
+/// Solve with the symmetric part only, for two right-hand sides in one pass.
+fn solve2(f: &Ldlt<'_>, a: &[f64], b: &[f64]) -> Result<(Vec<f64>, Vec<f64>), FeError> {
+    let n = a.len();
+    let mut m = Mat::<f64>::from_fn(n, 2, |i, j| if j == 0 { a[i] } else { b[i] });
+    f.solve_in_place(m.as_mut())?;
+    Ok((
+        (0..n).map(|i| m[(i, 0)]).collect(),
+        (0..n).map(|i| m[(i, 1)]).collect(),
+    ))
+}
+
 fn solve(f: &Ldlt<'_>, rhs: &[f64]) -> Result<Vec<f64>, FeError> {
     let mut m = Mat::<f64>::from_fn(rhs.len(), 1, |i, _| rhs[i]);
     f.solve_in_place(m.as_mut())?;
@@ -478,11 +489,21 @@ impl<'a, 'm> Solver<'a, 'm> {
                 break;
             }
             let t = Instant::now();
-            let (dur, _) = solve_t(&factor, &kv, p, &r)?;
-            let dut = if matches!(control, StepControl::Arc { .. }) {
-                solve_t(&factor, &kv, p, &p.q)?.0
+            let arc = matches!(control, StepControl::Arc { .. });
+            let (dur, dut) = if p.has_moments {
+                let dur = solve_t(&factor, &kv, p, &r)?.0;
+                let dut = if arc {
+                    solve_t(&factor, &kv, p, &p.q)?.0
+                } else {
+                    Vec::new()
+                };
+                (dur, dut)
+            } else if arc {
+                // Without applied moments the skew part vanishes at equilibrium: Newton with
+                // the symmetric part keeps its local convergence, at one solve per RHS.
+                solve2(&factor, &r, &p.q)?
             } else {
-                Vec::new()
+                (solve(&factor, &r)?, Vec::new())
             };
             let sol = Some((dur, dut));
             let Some((dur, dut)) = sol else {
