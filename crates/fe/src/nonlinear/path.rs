@@ -166,7 +166,8 @@ pub struct PathStep {
     pub iterations: usize,
     /// Negative pivots of the LDLᵀ of the tangent here (= its negative eigenvalues).
     pub negative_pivots: usize,
-    /// A limit point (load maximum or bifurcation) lies between the previous step and this.
+    /// The path's first limit point (load maximum or bifurcation, [`Path::limit`]) lies
+    /// between the previous step and this one.
     pub limit_passed: bool,
     /// Arc length of this step (W-norm of the displacement increment, m).
     pub arc_length: f64,
@@ -693,7 +694,6 @@ pub fn nonlinear_path(
     let mut limit: Option<LimitPoint> = None;
     let mut s_cum = vec![0.0];
     let mut rising = true;
-    let mut eig_prev: Option<f64> = None;
     let stop;
     loop {
         if steps.len() >= options.max_steps {
@@ -773,10 +773,7 @@ pub fn nonlinear_path(
                 passed = true;
                 // The eigenvalue that crossed zero: interpolate between its estimates.
                 let e1 = eig_near_zero(&c.factor, &c.kvals, &problem)?;
-                let e0 = match eig_prev {
-                    Some(e) => e,
-                    None => eig_near_zero(&factor, &kvals, &problem)?,
-                };
+                let e0 = eig_near_zero(&factor, &kvals, &problem)?;
                 let lam = if e0 > 0.0 && e1 < 0.0 {
                     lambda + (c.lambda - lambda) * e0 / (e0 - e1)
                 } else {
@@ -794,9 +791,6 @@ pub fn nonlinear_path(
         } else if c.lambda < lambda {
             rising = false;
         }
-        // Cheap estimate kept for a later bifurcation test: only when the inertia may change
-        // next (the path with a definite tangent needs none).
-        eig_prev = None;
         let ps = PathStep {
             step: idx + 1,
             lambda: c.lambda,
