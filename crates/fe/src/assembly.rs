@@ -160,45 +160,56 @@ where
         let end = (start + CHUNK).min(n_el);
         let mats: Vec<Mat18> = (start..end).into_par_iter().map(&matrix).collect();
         for (e, ke) in (start..end).zip(mats.iter()) {
-            let gd = element_dofs(&model.triangles[e]);
-            let fd: [usize; 18] = std::array::from_fn(|k| dofs.map[gd[k]]);
-            for q in 0..18 {
-                let j = fd[q];
-                if j == usize::MAX {
-                    continue;
-                }
-                let (c0, c1) = (pattern.col_ptr[j], pattern.col_ptr[j + 1]);
-                let rows = &pattern.row_idx[c0..c1];
-                // The free DOFs of one node are consecutive numbers, hence consecutive rows:
-                // one binary search per node block instead of one per entry.
-                for a in 0..3 {
-                    let mut pos: Option<usize> = None;
-                    for p in 6 * a..6 * a + 6 {
-                        let i = fd[p];
-                        if i == usize::MAX || i < j {
-                            continue;
-                        }
-                        let at = match pos {
-                            Some(x) => x + 1,
-                            None => c0 + rows.partition_point(|&r| r < i),
-                        };
-                        if pattern.row_idx.get(at) != Some(&i) || at >= c1 {
-                            return Err(FeError::Numerical {
-                                stage: "assembly",
-                                detail: format!(
-                                    "entry ({i}, {j}) missing from the sparsity pattern"
-                                ),
-                            });
-                        }
-                        vals[at] += ke[(p, q)];
-                        pos = Some(at);
-                    }
-                }
-            }
+            scatter(model, dofs, pattern, e, ke, &mut vals)?;
         }
         start = end;
     }
     Ok(vals)
+}
+
+/// Add the free-DOF lower-triangle entries of element `e`'s matrix `ke` into `vals`.
+pub(crate) fn scatter(
+    model: &ShellModel,
+    dofs: &DofMap,
+    pattern: &Pattern,
+    e: usize,
+    ke: &Mat18,
+    vals: &mut [f64],
+) -> Result<(), FeError> {
+    let gd = element_dofs(&model.triangles[e]);
+    let fd: [usize; 18] = std::array::from_fn(|k| dofs.map[gd[k]]);
+    for q in 0..18 {
+        let j = fd[q];
+        if j == usize::MAX {
+            continue;
+        }
+        let (c0, c1) = (pattern.col_ptr[j], pattern.col_ptr[j + 1]);
+        let rows = &pattern.row_idx[c0..c1];
+        // The free DOFs of one node are consecutive numbers, hence consecutive rows:
+        // one binary search per node block instead of one per entry.
+        for a in 0..3 {
+            let mut pos: Option<usize> = None;
+            for p in 6 * a..6 * a + 6 {
+                let i = fd[p];
+                if i == usize::MAX || i < j {
+                    continue;
+                }
+                let at = match pos {
+                    Some(x) => x + 1,
+                    None => c0 + rows.partition_point(|&r| r < i),
+                };
+                if pattern.row_idx.get(at) != Some(&i) || at >= c1 {
+                    return Err(FeError::Numerical {
+                        stage: "assembly",
+                        detail: format!("entry ({i}, {j}) missing from the sparsity pattern"),
+                    });
+                }
+                vals[at] += ke[(p, q)];
+                pos = Some(at);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Global load vector (6 per node): lumped self-weight `γ t A/3 · gravity` per node plus

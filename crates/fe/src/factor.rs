@@ -129,11 +129,15 @@ impl Symbolic {
             MemStack::new(&mut buf),
             Default::default(),
         );
-        let ldlt: LdltRef<'_, usize, f64> = match res {
-            Ok(f) => f,
-            Err(_) => return Ok(None),
-        };
-        let _ = ldlt;
+        if res.is_err() {
+            return Ok(None);
+        }
+        Ok(self.count_negative(&l))
+    }
+
+    /// Negative diagonal entries of D in the LDLᵀ values `l` (`None` on a zero or non-finite
+    /// pivot).
+    fn count_negative(&self, l: &[f64]) -> Option<usize> {
         // D sits on the diagonal of L (unit lower triangular otherwise).
         let mut neg = 0;
         match self.chol.raw() {
@@ -145,7 +149,7 @@ impl Symbolic {
                         if ri[p] == j {
                             let d = l[p];
                             if d == 0.0 || !d.is_finite() {
-                                return Ok(None);
+                                return None;
                             }
                             if d < 0.0 {
                                 neg += 1;
@@ -155,14 +159,14 @@ impl Symbolic {
                 }
             }
             SymbolicCholeskyRaw::Supernodal(s) => {
-                let f = faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef::new(s, &l);
+                let f = faer::sparse::linalg::cholesky::supernodal::SupernodalLdltRef::new(s, l);
                 for k in 0..s.n_supernodes() {
                     let sn = f.supernode(k);
                     let v = sn.val();
                     for i in 0..v.ncols() {
                         let d = v[(i, i)];
                         if d == 0.0 || !d.is_finite() {
-                            return Ok(None);
+                            return None;
                         }
                         if d < 0.0 {
                             neg += 1;
@@ -171,7 +175,70 @@ impl Symbolic {
                 }
             }
         }
-        Ok(Some(neg))
+        Some(neg)
+    }
+
+    /// Numeric LDLᵀ (no pivoting) of a symmetric, possibly indefinite matrix with lower values
+    /// `vals`, kept for solves; `None` on a zero or non-finite pivot (a singular tangent).
+    pub(crate) fn ldlt(&self, p: &Pattern, vals: &[f64]) -> Result<Option<Ldlt<'_>>, FeError> {
+        let oom = |what: &str| FeError::Numerical {
+            stage: "LDLᵀ (tangent)",
+            detail: format!("out of memory for the {what}"),
+        };
+        let mut l = Vec::new();
+        l.try_reserve_exact(self.chol.len_val())
+            .map_err(|_| oom("factor"))?;
+        l.resize(self.chol.len_val(), 0.0);
+        let req = self
+            .chol
+            .factorize_numeric_ldlt_scratch::<f64>(par(), Default::default());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| oom("workspace"))?;
+        let res = self.chol.factorize_numeric_ldlt::<f64>(
+            &mut l,
+            Self::mat(p, vals),
+            Side::Lower,
+            Default::default(),
+            par(),
+            MemStack::new(&mut buf),
+            Default::default(),
+        );
+        if res.is_err() {
+            return Ok(None);
+        }
+        Ok(self.count_negative(&l).map(|negative| Ldlt {
+            sym: self,
+            l,
+            negative,
+        }))
+    }
+}
+
+/// Numeric LDLᵀ factor of a symmetric (possibly indefinite) matrix, with its inertia.
+pub(crate) struct Ldlt<'a> {
+    sym: &'a Symbolic,
+    l: Vec<f64>,
+    /// Number of negative pivots = negative eigenvalues (Sylvester).
+    pub(crate) negative: usize,
+}
+
+impl Ldlt<'_> {
+    /// Solve `A X = B` in place for all columns of `rhs`.
+    pub(crate) fn solve_in_place(&self, rhs: MatMut<'_, f64>) -> Result<(), FeError> {
+        let req = self
+            .sym
+            .chol
+            .solve_in_place_scratch::<f64>(rhs.ncols(), par());
+        let mut buf = MemBuffer::try_new(req).map_err(|_| FeError::Numerical {
+            stage: "solve",
+            detail: "out of memory for the workspace".into(),
+        })?;
+        LdltRef::<'_, usize, f64>::new(&self.sym.chol, &self.l).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            par(),
+            MemStack::new(&mut buf),
+        );
+        Ok(())
     }
 }
 

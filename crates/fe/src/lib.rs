@@ -16,6 +16,11 @@
 //!   drilling freedoms + DKT, [`element::dkmt::AndesDkmt`] / [`element::dkmt::CstDkmt`] the
 //!   shear-deformable (Reissner–Mindlin, DKMT plate) variants for thick shells, chosen by
 //!   [`ShellModel::element`] ([`ElementKind`]).
+//! * [`nonlinear`]: geometrically nonlinear statics — co-rotational facets (small strains,
+//!   large rotations), [`nonlinear_path`] (Newton–Raphson with Crisfield's arc length or load
+//!   control, limit points and bifurcations from the tangent's inertia, residual per step),
+//!   [`with_imperfection`] (a scaled buckling mode added to the nodes) and
+//!   [`deformed_resultants`] (stresses in a deformed state).
 //! * [`mesh_json`] reads the fixture mesh format of `../shared/fixtures/fe/`.
 //!
 //! ```
@@ -48,12 +53,17 @@ mod factor;
 pub mod generate;
 pub mod mesh_json;
 pub mod model;
+pub mod nonlinear;
 pub mod oracle;
 mod solver;
 pub mod summary;
 
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
+pub use nonlinear::{
+    Path, PathControl, PathOptions, PathStep, StopReason, deformed_resultants, nonlinear_path,
+    with_imperfection,
+};
 pub use solver::{
     BucklingOptions, BucklingResult, BucklingSolver, ElementResult, SolveStats, StaticResult,
     SturmCheck, buckling, linear_static,

@@ -11,4 +11,5 @@ mod common;
 mod element_patch;
 mod fixtures;
 mod mindlin;
+mod nonlinear;
 mod solver_checks;

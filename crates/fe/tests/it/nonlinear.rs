@@ -1,0 +1,610 @@
+//! Geometrically nonlinear statics (issue 23): co-rotational facets and path following
+//! against closed forms and published shell benchmarks.
+
+use std::ops::ControlFlow;
+
+use kappe_fe::{
+    BucklingOptions, FeError, NodalLoad, PathControl, PathOptions, ShellModel, StopReason, Support,
+    buckling, deformed_resultants, nonlinear_path, with_imperfection,
+};
+
+use crate::common::material;
+
+/// A strip along x, `n` cells long and one cell wide (two triangles per cell), clamped at
+/// x = 0. Node (i, j) = 2i + j, j = 0, 1 across the width b.
+fn strip(l: f64, b: f64, t: f64, e: f64, n: usize) -> ShellModel {
+    let mut nodes = Vec::new();
+    for i in 0..=n {
+        for j in 0..2 {
+            nodes.push([l * i as f64 / n as f64, b * j as f64, 0.0]);
+        }
+    }
+    let mut tris = Vec::new();
+    for i in 0..n {
+        let a = 2 * i;
+        tris.push([a, a + 2, a + 3]);
+        tris.push([a, a + 3, a + 1]);
+    }
+    let mut m = ShellModel::new(nodes, tris, t, material(e, 0.0, 0.0));
+    m.gravity = [0.0; 3];
+    m.supports = vec![Support::clamped(0), Support::clamped(1)];
+    m
+}
+
+fn run(model: &ShellModel, opt: &PathOptions) -> kappe_fe::Path {
+    nonlinear_path(model, opt, &mut |_| ControlFlow::Continue(())).unwrap()
+}
+
+/// A cantilever strip rolled up by an end moment M = λ·2πEI/L (ν = 0, so the strip's plate
+/// stiffness is EI). Exact (Euler–Bernoulli, inextensible): the axis is a circular arc of
+/// angle θ = ML/EI, tip at u = L(sin θ/θ − 1), w = L(1 − cos θ)/θ; at λ = 1 the tip is back at
+/// the root. Tolerance 0.5 % of L on the tip position at every step: 40 flat facets along
+/// the strip make a polygon inscribed in the arc; its chord-vs-arc radius error is
+/// (Δφ)²/24 = 0.1 % at Δφ = 2π/40, and the tip error is of that order times L.
+#[test]
+fn cantilever_rolled_into_a_circle() {
+    let (l, b, t, e, n) = (1.0, 0.05, 0.01, 1.0e7, 40);
+    let mut m = strip(l, b, t, e, n);
+    let ei = e * b * t.powi(3) / 12.0;
+    let m_full = 2.0 * std::f64::consts::PI * ei / l;
+    // A moment about −y bends the strip upwards (+z).
+    for node in [2 * n, 2 * n + 1] {
+        m.nodal_loads.push(NodalLoad {
+            node,
+            force: [0.0; 3],
+            moment: [0.0, -0.5 * m_full, 0.0],
+        });
+    }
+    let opt = PathOptions {
+        control: PathControl::Load,
+        initial_increment: 0.125,
+        max_step_ratio: 1.0,
+        lambda_max: 1.0,
+        stop_at_limit: false,
+        ..Default::default()
+    };
+    let path = run(&m, &opt);
+    assert_eq!(path.stop, StopReason::LambdaMax, "{:?}", path.stop);
+    assert!(path.steps.len() >= 8);
+    let mut worst: f64 = 0.0;
+    for s in &path.steps {
+        let th = s.lambda * 2.0 * std::f64::consts::PI;
+        let (u_ex, w_ex) = (l * (th.sin() / th - 1.0), l * (1.0 - th.cos()) / th);
+        let tip: Vec<[f64; 3]> = [2 * n, 2 * n + 1]
+            .iter()
+            .map(|&k| s.translation(k).unwrap())
+            .collect();
+        let u = 0.5 * (tip[0][0] + tip[1][0]);
+        let w = 0.5 * (tip[0][2] + tip[1][2]);
+        let err = ((u - u_ex).powi(2) + (w - w_ex).powi(2)).sqrt() / l;
+        worst = worst.max(err);
+        assert!(
+            err < 5e-3,
+            "λ = {}: tip ({u:.5}, {w:.5}) vs exact ({u_ex:.5}, {w_ex:.5}), error {err:.2e} L",
+            s.lambda
+        );
+        assert!(s.residual <= opt.tolerance);
+    }
+    eprintln!("rolled cantilever: worst tip error {worst:.2e} L");
+    let last = path.steps.last().unwrap();
+    assert!((last.lambda - 1.0).abs() < 1e-12);
+    // Stresses in the deformed state: pure bending, M = M_full/b about the width axis (global
+    // y, unchanged by the planar roll-up) in every facet, no membrane force. Tolerance 1 %:
+    // each facet carries the exact constant curvature of its chord.
+    let res = deformed_resultants(&m, &last.displacements).unwrap();
+    for (e, r) in res.iter().enumerate() {
+        // Global y in the facet's current local axes, and the in-plane axis across it.
+        let (wy1, wy2) = (r.frame[0][1], r.frame[1][1]);
+        assert!(
+            (wy1 * wy1 + wy2 * wy2 - 1.0).abs() < 1e-6,
+            "facet {e} left the x-z plane"
+        );
+        let (a1, a2) = (wy2, -wy1);
+        let [mx, my, mxy] = r.resultants.moment;
+        let m_axis = mx * a1 * a1 + my * a2 * a2 + 2.0 * mxy * a1 * a2;
+        let m_width = mx * wy1 * wy1 + my * wy2 * wy2 + 2.0 * mxy * wy1 * wy2;
+        assert!(
+            (m_axis.abs() / (m_full / b) - 1.0).abs() < 0.01,
+            "element {e}: M = {m_axis}, expected {}",
+            m_full / b
+        );
+        assert!(m_width.abs() < 0.01 * m_full / b, "element {e}: {m_width}");
+        let n = r.resultants.membrane;
+        assert!(
+            n.iter().all(|v| v.abs() < 1e-3 * m_full / b / t),
+            "element {e}: N = {n:?}"
+        );
+    }
+}
+
+/// Complete elliptic integrals K(k), E(k) by the arithmetic–geometric mean (Abramowitz &
+/// Stegun 17.6): K = π/(2 a_N), E = K (1 − Σ 2^(n−1) c_n²), c₀ = k.
+fn elliptic_ke(k: f64) -> (f64, f64) {
+    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
+    let mut sum = 0.5 * k * k;
+    let mut pow = 0.5;
+    for _ in 0..40 {
+        let c = 0.5 * (a - b);
+        let (an, bn) = (0.5 * (a + b), (a * b).sqrt());
+        pow *= 2.0;
+        sum += pow * c * c;
+        a = an;
+        b = bn;
+        if c.abs() < 1e-16 {
+            break;
+        }
+    }
+    let kk = std::f64::consts::PI / (2.0 * a);
+    (kk, kk * (1.0 - sum))
+}
+
+#[test]
+fn elliptic_integrals_match_tables() {
+    // A&S table 17.1 at k² = 0.5: K = 1.854074677, E = 1.350643881.
+    let (k, e) = elliptic_ke(0.5f64.sqrt());
+    assert!((k - 1.854_074_677).abs() < 1e-8 && (e - 1.350_643_881).abs() < 1e-8);
+}
+
+/// The elastica of a post-buckled cantilever column (clamped base, axial tip load P, free
+/// top; Timoshenko & Gere, Theory of Elastic Stability §2.7): with tip rotation α and
+/// k = sin(α/2), P/P_cr = (2K(k)/π)², P_cr = π²EI/(4L²), lateral tip deflection
+/// δ/L = 2k/K(k), and the tip's axial position (L − Δ)/L = 2E(k)/K(k) − 1. The column starts
+/// from its first buckling mode scaled to w0 = 10⁻⁴ L (the perfect column has no unique
+/// post-buckling path). Tolerances, for every step with α ≥ 20°: 1 % on P/P_cr and 1 % of L
+/// on both tip displacements. Discretisation: 40 facets give P_cr within ~0.1 % of the
+/// beam value; the imperfection shifts P by ≈ w0/δ ≤ 0.1 % at α ≥ 20° (δ ≥ 0.2 L).
+#[test]
+fn post_buckled_cantilever_column_follows_the_elastica() {
+    let (l, b, t, e, n) = (1.0, 0.05, 0.01, 1.0e7, 40);
+    let mut m = strip(l, b, t, e, n);
+    let ei = e * b * t.powi(3) / 12.0;
+    let pcr = std::f64::consts::PI.powi(2) * ei / (4.0 * l * l);
+    for node in [2 * n, 2 * n + 1] {
+        m.nodal_loads.push(NodalLoad {
+            node,
+            force: [-0.5 * pcr, 0.0, 0.0],
+            moment: [0.0; 3],
+        });
+    }
+    let lba = buckling(
+        &m,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert!((lba.factors[0] - 1.0).abs() < 5e-3, "{}", lba.factors[0]);
+    let imperfect = with_imperfection(&m, &lba.modes[0], 1e-4 * l).unwrap();
+    let opt = PathOptions {
+        initial_increment: 0.2,
+        lambda_max: 2.5,
+        stop_at_limit: false,
+        max_steps: 300,
+        ..Default::default()
+    };
+    let path = run(&imperfect, &opt);
+    assert!(
+        matches!(path.stop, StopReason::LambdaMax),
+        "{:?}",
+        path.stop
+    );
+    let mut checked = 0;
+    let mut worst = [0.0f64; 3];
+    for s in &path.steps {
+        let tip: Vec<[f64; 6]> = [2 * n, 2 * n + 1]
+            .iter()
+            .map(|&k| s.displacements[k])
+            .collect();
+        let alpha = 0.5 * (tip[0][4] + tip[1][4]).abs();
+        if alpha < 20f64.to_radians() {
+            continue;
+        }
+        let k = (0.5 * alpha).sin();
+        let (kk, ee) = elliptic_ke(k);
+        let ratio = (2.0 * kk / std::f64::consts::PI).powi(2);
+        let delta = 0.5 * (tip[0][2] + tip[1][2]).abs();
+        let axial = l + 0.5 * (tip[0][0] + tip[1][0]);
+        worst[0] = worst[0].max((s.lambda / ratio - 1.0).abs());
+        worst[1] = worst[1].max((delta - 2.0 * k / kk * l).abs() / l);
+        worst[2] = worst[2].max((axial - (2.0 * ee / kk - 1.0) * l).abs() / l);
+        assert!(
+            (s.lambda / ratio - 1.0).abs() < 0.01,
+            "α = {:.1}°: P/Pcr = {:.4}, elastica {ratio:.4}",
+            alpha.to_degrees(),
+            s.lambda
+        );
+        assert!((delta - 2.0 * k / kk * l).abs() < 0.01 * l, "δ = {delta}");
+        assert!(
+            (axial - (2.0 * ee / kk - 1.0) * l).abs() < 0.01 * l,
+            "axial {axial}"
+        );
+        checked += 1;
+    }
+    eprintln!(
+        "elastica: worst P/Pcr, δ/L, axial/L errors {:.2e}, {:.2e}, {:.2e} over {checked} steps",
+        worst[0], worst[1], worst[2]
+    );
+    // λ = 2.5 is α ≈ 140°: the path must have covered it in several steps.
+    assert!(checked >= 5, "only {checked} steps beyond 20°");
+}
+
+/// Strip facets between two rails of node indices (y = 0 and y = b sides).
+fn strip_triangles(a: &[usize], b: &[usize], tris: &mut Vec<[usize; 3]>) {
+    for k in 0..a.len() - 1 {
+        tris.push([a[k], a[k + 1], b[k + 1]]);
+        tris.push([a[k], b[k + 1], b[k]]);
+    }
+}
+
+/// Roorda's frame (Roorda 1965; Koiter's asymmetric bifurcation): a vertical column and a
+/// horizontal beam, both strips of length L, rigidly joined at the top of the column, the
+/// column's foot and the beam's far end hinged (about y), under a vertical load P at the
+/// joint. `n` facets per member. P_ref = π²EI/L².
+fn roorda_frame(n: usize) -> (ShellModel, Vec<usize>) {
+    let (l, b, t, e) = (1.0, 0.05, 0.01, 1.0e7);
+    let mut nodes = Vec::new();
+    let (mut ra, mut rb) = (Vec::new(), Vec::new());
+    for i in 0..=n {
+        ra.push(nodes.len());
+        nodes.push([0.0, 0.0, l * i as f64 / n as f64]);
+        rb.push(nodes.len());
+        nodes.push([0.0, b, l * i as f64 / n as f64]);
+    }
+    let joint = vec![ra[n], rb[n]];
+    let (mut sa, mut sb) = (vec![ra[n]], vec![rb[n]]);
+    for i in 1..=n {
+        sa.push(nodes.len());
+        nodes.push([l * i as f64 / n as f64, 0.0, l]);
+        sb.push(nodes.len());
+        nodes.push([l * i as f64 / n as f64, b, l]);
+    }
+    let mut tris = Vec::new();
+    strip_triangles(&ra, &rb, &mut tris);
+    strip_triangles(&sa, &sb, &mut tris);
+    let mut m = ShellModel::new(nodes, tris, t, material(e, 0.0, 0.0));
+    m.gravity = [0.0; 3];
+    m.supports = [ra[0], rb[0], sa[n], sb[n]]
+        .iter()
+        .map(|&k| Support::pinned(k))
+        .collect();
+    let p_ref = std::f64::consts::PI.powi(2) * e * b * t.powi(3) / 12.0 / (l * l);
+    for &k in &joint {
+        m.nodal_loads.push(NodalLoad {
+            node: k,
+            force: [0.0, 0.0, -0.5 * p_ref],
+            moment: [0.0; 3],
+        });
+    }
+    (m, joint)
+}
+
+/// λ_collapse → λ_LBA as w0 → 0, on Roorda's frame: its pre-buckling state is pure axial
+/// compression of the column (linear up to O(axial strain) ≈ 1e-4), and its bifurcation is
+/// asymmetric, unstable for one sign of the sway (Koiter: the limit load of the imperfect
+/// frame falls short of λ_c by ∝ √w0). The imperfection is the frame's first linear
+/// buckling mode scaled to ±w0; the collapse factor at each w0 is the smaller limit of the
+/// two signs (either kind of limit: with w0 → 0 the path of the stable sign also crosses the
+/// critical point, seen as a change of the tangent's inertia). Checked: the frame's λ_LBA against the closed form of a column hinged at its
+/// foot and elastically restrained at its top by the beam (rotational spring 3EI/L):
+/// P_c = 1.407 π²EI/L², within 0.5 % (20 facets per member); the collapse factors rise monotonically as w0 falls, never exceed λ_LBA by more
+/// than the 0.2 % gap between the co-rotational tangent's and the linear solver's
+/// geometric stiffness on this mesh, and at w0 = 10⁻⁶ L are within 1 % of λ_LBA.
+#[test]
+fn collapse_factor_tends_to_linear_buckling_factor() {
+    let (m, _) = roorda_frame(20);
+    let lba = buckling(
+        &m,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let lam_lba = lba.factors[0];
+    // Column hinged at the foot, its top held laterally (the beam is axially rigid) and
+    // restrained against rotation by the beam, hinged at its far end: spring c = 3EI/L.
+    // y = A sin ks + C s satisfies the foot; y(L) = 0 and EI y''(L) = −c y'(L) give, with
+    // x = kL: f(x) = x² sin x + 3 sin x − 3x cos x = 0, root between π (c = 0) and 4.493
+    // (c = ∞, tan x = x); Roorda's P_c = 1.407 π²EI/L².
+    let f = |x: f64| x * x * x.sin() + 3.0 * x.sin() - 3.0 * x * x.cos();
+    let (mut lo, mut hi) = (std::f64::consts::PI + 1e-9, 4.49);
+    assert!(f(lo) * f(hi) < 0.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f(lo) * f(mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let lam_exact = (0.5 * (lo + hi) / std::f64::consts::PI).powi(2);
+    eprintln!("Roorda frame: λ_LBA = {lam_lba:.5}, closed form {lam_exact:.5}");
+    assert!((lam_lba / lam_exact - 1.0).abs() < 5e-3);
+    let mut limits = Vec::new();
+    for w0 in [1e-3, 1e-4, 1e-5, 1e-6] {
+        let mut best = f64::INFINITY;
+        for sign in [1.0, -1.0] {
+            let mi = with_imperfection(&m, &lba.modes[0], sign * w0).unwrap();
+            let opt = PathOptions {
+                initial_increment: 0.2 * lam_lba,
+                lambda_max: 1.5 * lam_lba,
+                max_steps: 80,
+                ..Default::default()
+            };
+            let path = run(&mi, &opt);
+            if let Some(lim) = path.limit {
+                best = best.min(lim.lambda);
+            }
+        }
+        assert!(
+            best.is_finite(),
+            "no limit point for either sign at w0 = {w0}"
+        );
+        limits.push((w0, best / lam_lba));
+    }
+    eprintln!("(w0/L, λ_collapse/λ_LBA): {limits:?}");
+    for w in limits.windows(2) {
+        assert!(w[1].1 >= w[0].1, "{limits:?}");
+    }
+    assert!(limits.iter().all(|l| l.1 < 1.002), "{limits:?}");
+    let last = limits.last().unwrap();
+    assert!((last.1 - 1.0).abs() < 0.01, "{limits:?}");
+    // Koiter's asymmetric law 1 − λ_s/λ_c ∝ √w0: a decade of w0 is a factor √10 ≈ 3.16 on
+    // the shortfall while it is well above the 0.2 % tangent-vs-LBA gap (w0 = 1e-3, 1e-4).
+    let r = (1.0 - limits[0].1) / (1.0 - limits[1].1);
+    assert!((2.6..3.8).contains(&r), "shortfall ratio {r}: {limits:?}");
+}
+
+/// Elastica of a cantilever under a fixed-direction tip load P (perpendicular to the
+/// undeformed axis), by shooting: EI θ'' = −P cos θ, θ(0) = 0, θ'(L) = 0, with RK4 on
+/// 4000 steps and bisection on θ'(0); returns the tip's (u, w) (u axial, w along P). An
+/// independent reference (beam theory, inextensible), not our output.
+fn tip_loaded_elastica(p_over_ei: f64, l: f64) -> (f64, f64) {
+    let n = 4000;
+    let h = l / n as f64;
+    // State (θ, θ', x, z).
+    let shoot = |k0: f64| -> [f64; 4] {
+        let rhs = |y: [f64; 4]| [y[1], -p_over_ei * y[0].cos(), y[0].cos(), y[0].sin()];
+        let mut y = [0.0, k0, 0.0, 0.0];
+        for _ in 0..n {
+            let k1 = rhs(y);
+            let k2 = rhs(std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+            let k3 = rhs(std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+            let k4 = rhs(std::array::from_fn(|i| y[i] + h * k3[i]));
+            y = std::array::from_fn(|i| {
+                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+        }
+        y
+    };
+    // θ'(0) = P x_tip/EI lies in (0, P L/EI]; θ'(L) is increasing in θ'(0) there.
+    let (mut lo, mut hi) = (0.0, p_over_ei * l);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if shoot(mid)[1] > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let y = shoot(0.5 * (lo + hi));
+    (y[2] - l, y[3])
+}
+
+/// Sze, Liu & Lo (2004) §3.1, cantilever under end shear: L = 10, b = 1, t = 0.1,
+/// E = 1.2e6, ν = 0, tip load P up to 4 (PL²/EI = 4). Their tabulated reference is a fine
+/// S4R solution of this beam problem; here the reference is the elastica itself
+/// ([`tip_loaded_elastica`]), and at P = 4 both Sze's and Mattiasson's (1981) published tip
+/// values −u = 3.29, w = 6.70 (to the digits we compare) — checked here against the shooting
+/// to 0.2 %. Tolerance on the FE tip at every step: 1 % of L: 32 DKT facets along the beam
+/// have a bending error ~ (h/L)² ≈ 0.1 %, and the load is a dead load in z.
+#[test]
+fn sze_cantilever_under_end_shear() {
+    let (l, b, t, e, n) = (10.0, 1.0, 0.1, 1.2e6, 32);
+    let mut m = strip(l, b, t, e, n);
+    let ei = e * b * t.powi(3) / 12.0;
+    let p_max = 4.0;
+    for node in [2 * n, 2 * n + 1] {
+        m.nodal_loads.push(NodalLoad {
+            node,
+            force: [0.0, 0.0, 0.5 * p_max],
+            moment: [0.0; 3],
+        });
+    }
+    let (u4, w4) = tip_loaded_elastica(p_max / ei, l);
+    assert!(
+        (-u4 / 3.29 - 1.0).abs() < 2e-3 && (w4 / 6.70 - 1.0).abs() < 2e-3,
+        "{u4} {w4}"
+    );
+    let opt = PathOptions {
+        control: PathControl::Load,
+        initial_increment: 0.1,
+        lambda_max: 1.0,
+        stop_at_limit: false,
+        ..Default::default()
+    };
+    let path = run(&m, &opt);
+    assert_eq!(path.stop, StopReason::LambdaMax);
+    let mut worst: f64 = 0.0;
+    for s in &path.steps {
+        let (ue, we) = tip_loaded_elastica(s.lambda * p_max / ei, l);
+        let tip: Vec<[f64; 3]> = [2 * n, 2 * n + 1]
+            .iter()
+            .map(|&k| s.translation(k).unwrap())
+            .collect();
+        let (u, w) = (0.5 * (tip[0][0] + tip[1][0]), 0.5 * (tip[0][2] + tip[1][2]));
+        let err = (u - ue).abs().max((w - we).abs()) / l;
+        worst = worst.max(err);
+        assert!(
+            err < 0.01,
+            "P = {}: FE ({u}, {w}) vs elastica ({ue}, {we})",
+            s.lambda * p_max
+        );
+    }
+    eprintln!(
+        "Sze 3.1: worst tip error {worst:.2e} L over {} steps",
+        path.steps.len()
+    );
+}
+
+/// Quarter model of the hinged cylindrical roof (Sze, Liu & Lo 2004 §3.7; Sabir & Lock 1972):
+/// R = 2540 mm, axial half-length 254 mm, half-angle 0.1 rad, E = 3102.75 N/mm², ν = 0.3,
+/// straight edges hinged, curved edges free, central point load P = λ · 1 kN.
+/// `n × n` cells, ANDES membrane + DKT (the CST membrane is too stiff on a shallow shell).
+fn hinged_roof(t: f64, n: usize) -> (ShellModel, usize) {
+    let (r, half_len, theta) = (2540.0f64, 254.0, 0.1f64);
+    let mut nodes = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let x = half_len * i as f64 / n as f64;
+            let phi = theta * j as f64 / n as f64;
+            nodes.push([x, r * phi.sin(), r * phi.cos()]);
+        }
+    }
+    let tris = kappe_fe::generate::alternating_triangles(n, n);
+    let mut m = ShellModel::new(nodes, tris, t, material(3102.75, 0.3, 0.0));
+    m.gravity = [0.0; 3];
+    m.element = kappe_fe::ElementKind::AndesDkt;
+    let id = |i: usize, j: usize| j * (n + 1) + i;
+    let mut sup = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let mut f = [false; 6];
+            if i == 0 {
+                // Symmetry plane x = 0: ux, ry, rz.
+                f[0] = true;
+                f[4] = true;
+                f[5] = true;
+            }
+            if j == 0 {
+                // Symmetry plane y = 0: uy, rx, rz.
+                f[1] = true;
+                f[3] = true;
+                f[5] = true;
+            }
+            if j == n {
+                // Hinged straight edge.
+                f[0] = true;
+                f[1] = true;
+                f[2] = true;
+            }
+            if f.iter().any(|b| *b) {
+                sup.push(Support {
+                    node: id(i, j),
+                    fixed: f,
+                });
+            }
+        }
+    }
+    m.supports = sup;
+    m.nodal_loads.push(NodalLoad {
+        node: id(0, 0),
+        force: [0.0, 0.0, -1000.0 / 4.0],
+        moment: [0.0; 3],
+    });
+    (m, id(0, 0))
+}
+
+/// Hinged cylindrical roof, t = 6.35 mm: snap-through with snap-back. Published curve
+/// (Sze et al. 2004 Fig./Table for h = 6.35; the same curve in Kadapa 2021, Eng. Struct.
+/// 234: 111755, whose points are digitised in the ACALM repository of Siqi et al.): first
+/// limit load P ≈ 0.58 kN at a centre deflection of 12–14 mm; the path then snaps back
+/// (deflection decreasing to ≈ 14.5 mm) through a load minimum P ≈ −0.38 kN near 15–16 mm,
+/// and recovers to P = 0 near w ≈ 25 mm. Tolerances: limit load 4 %, minimum load 8 %,
+/// deflection of the limit within 11–15 mm, zero crossing of the rising branch within
+/// 23–27 mm. Our quarter mesh is 12 × 12 cells (ANDES + DKT): the limit load is 0.5871,
+/// 0.5865 and 0.5861 kN on 12², 16² and 24² meshes (converged to 0.2 %), so the tolerance
+/// covers the reference's own spread (different elements and meshes in the literature, a
+/// few %) and the ~1 % reading error of digitised curves.
+#[test]
+fn sze_hinged_roof_snap_through() {
+    let (m, centre) = hinged_roof(6.35, 12);
+    let opt = PathOptions {
+        initial_increment: 0.05,
+        lambda_max: 1.0,
+        stop_at_limit: false,
+        max_arc_length: Some(1.0),
+        max_steps: 400,
+        ..Default::default()
+    };
+    let mut curve = Vec::new();
+    let path = nonlinear_path(&m, &opt, &mut |s| {
+        curve.push((-s.displacements[centre][2], s.lambda));
+        if -s.displacements[centre][2] > 30.0 {
+            ControlFlow::Break(StopReason::Caller("w > 30 mm".into()))
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+    .unwrap();
+    let lim = path.limit.expect("no limit point");
+    let w_lim = -path.steps[lim.step - 1].displacements[centre][2];
+    let p_min = curve.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let w_back = curve
+        .iter()
+        .skip_while(|c| c.1 > p_min)
+        .map(|c| c.0)
+        .next()
+        .unwrap_or(f64::NAN);
+    let w_zero = curve
+        .windows(2)
+        .filter(|w| w[0].1 < 0.0 && w[1].1 >= 0.0 && w[1].0 > 20.0)
+        .map(|w| w[0].0 + (w[1].0 - w[0].0) * (-w[0].1) / (w[1].1 - w[0].1))
+        .next()
+        .unwrap_or(f64::NAN);
+    eprintln!(
+        "roof t = 6.35: P_lim = {:.4} kN at w = {w_lim:.2} mm, P_min = {p_min:.4} kN at w = {w_back:.2} mm, P = 0 again at w = {w_zero:.2} mm; {} steps, {:?}",
+        lim.lambda,
+        path.steps.len(),
+        path.stop
+    );
+    for s in &path.steps {
+        assert!(s.residual <= opt.tolerance);
+    }
+    assert!(
+        (lim.lambda / 0.58 - 1.0).abs() < 0.04,
+        "P_lim {}",
+        lim.lambda
+    );
+    assert!((11.0..15.0).contains(&w_lim), "w_lim {w_lim}");
+    assert!((p_min / -0.38 - 1.0).abs() < 0.08, "P_min {p_min}");
+    assert!((23.0..27.0).contains(&w_zero), "w at P = 0 {w_zero}");
+}
+
+/// Bad inputs are typed errors naming the field.
+#[test]
+fn nonlinear_bad_inputs() {
+    let mut m = strip(1.0, 0.05, 0.01, 1e7, 4);
+    let bad = PathOptions {
+        initial_increment: 0.0,
+        ..Default::default()
+    };
+    let cont = &mut |_: &kappe_fe::PathStep| ControlFlow::Continue(());
+    match nonlinear_path(&m, &bad, cont) {
+        Err(FeError::BadOption { field, .. }) => assert_eq!(field, "initial_increment"),
+        other => panic!("{other:?}"),
+    }
+    // No load at all.
+    assert!(matches!(
+        nonlinear_path(&m, &PathOptions::default(), cont),
+        Err(FeError::Empty { .. })
+    ));
+    m.nodal_loads.push(NodalLoad {
+        node: 9,
+        force: [0.0, 0.0, 1.0],
+        moment: [0.0; 3],
+    });
+    assert!(matches!(
+        with_imperfection(&m, &[[0.0; 6]; 3], 1e-3),
+        Err(FeError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        with_imperfection(&m, &vec![[0.0; 6]; m.nodes.len()], 1e-3),
+        Err(FeError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        deformed_resultants(&m, &[[0.0; 6]; 2]),
+        Err(FeError::OutOfRange { .. })
+    ));
+}
