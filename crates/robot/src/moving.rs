@@ -33,8 +33,9 @@
 //! scored on a sample of the print (`score_layers` layers spread over it, every `score_stride`-th
 //! target and each layer's last): a lead is feasible when every sampled target has a valid
 //! configuration (the planner's own acceptance: limits, singularity margins, self-collision,
-//! clearance to beams, floor and printed layers). Among the feasible leads the one farthest (in
-//! grid steps) from any infeasible lead is taken: its **reach margin**, how far the base may be
+//! clearance to beams, floor and printed layers; the grid is scanned every 5th lead and each
+//! feasibility boundary bisected, [`coarse_to_fine`]). Among the feasible leads the one farthest
+//! (in grid steps) from any infeasible lead is taken: its **reach margin**, how far the base may be
 //! off along the bay before a sampled target becomes unreachable, is `(m − 1)·lead_step` for
 //! m steps to the nearest infeasible lead (the boundary lies somewhere in the last step).
 //! This trades nothing against base speed: the base speed is the front's, set by the print, and
@@ -493,17 +494,15 @@ fn search_leads(
         })
         .collect();
     // The body against the beams and the print at every sampled layer's start, then the targets.
-    let feasible: Vec<bool> = cands
-        .par_iter()
-        .map(|&lead| {
-            sample_layers
+    let eval = |lead: f64| {
+        sample_layers
+            .iter()
+            .all(|&o| body_ok(&base.pose_at(lead + offsets[o][0])))
+            && samples
                 .iter()
-                .all(|&o| body_ok(&base.pose_at(lead + offsets[o][0])))
-                && samples
-                    .iter()
-                    .all(|&(o, k)| geo.reachable(&base.pose_at(lead + offsets[o][k]), o, k))
-        })
-        .collect();
+                .all(|&(o, k)| geo.reachable(&base.pose_at(lead + offsets[o][k]), o, k))
+    };
+    let feasible = coarse_to_fine(cands.len(), COARSE, &|i| eval(cands[i]));
     // Grid steps to the nearest infeasible lead (the grid's ends count as infeasible beyond).
     let m = cands.len();
     let steps: Vec<usize> = (0..m)
@@ -551,6 +550,56 @@ fn search_leads(
         .filter(|&i| margin(i) >= base.min_reach_margin)
         .map(|i| (cands[i], Some(margin(i))))
         .collect())
+}
+
+/// Coarse grid stride of the lead search.
+const COARSE: usize = 5;
+
+/// Feasibility of grid points `0..m`, evaluating every `coarse`-th point (and the last) and then
+/// bisecting each boundary between a feasible and an infeasible coarse point down to one grid
+/// step. Points between two feasible coarse points are taken as feasible: a pocket narrower than
+/// `coarse` steps inside a feasible run would be missed, which can only make a reach margin
+/// optimistic (the full ladder over every target still decides the plan), and it cuts the
+/// expensive evaluations (feasible leads run through every sample) about `coarse`-fold.
+fn coarse_to_fine(m: usize, coarse: usize, eval: &(dyn Fn(usize) -> bool + Sync)) -> Vec<bool> {
+    if m == 0 {
+        return Vec::new();
+    }
+    let mut idx: Vec<usize> = (0..m).step_by(coarse.max(1)).collect();
+    if idx.last() != Some(&(m - 1)) {
+        idx.push(m - 1);
+    }
+    let ok: Vec<bool> = idx.par_iter().map(|&i| eval(i)).collect();
+    let mut out = vec![false; m];
+    for w in 0..idx.len() {
+        if ok[w] {
+            out[idx[w]] = true;
+        }
+        let Some(&next) = idx.get(w + 1) else { break };
+        let (a, b) = (idx[w], next);
+        match (ok[w], ok[w + 1]) {
+            (true, true) => out[a..=b].iter_mut().for_each(|v| *v = true),
+            (false, false) => {}
+            (fa, _) => {
+                // One boundary in (a, b): bisect for the last point on a's side.
+                let (mut lo, mut hi) = (a, b);
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    if eval(mid) == fa {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                if fa {
+                    out[a..=lo].iter_mut().for_each(|v| *v = true);
+                } else {
+                    out[hi..=b].iter_mut().for_each(|v| *v = true);
+                }
+            }
+        }
+    }
+    out
 }
 
 fn plan_with_lead(
@@ -1130,4 +1179,28 @@ pub fn resume_moving(mp: &MovingPlan, layer: i64) -> Result<MovingPlan, RobotErr
         return Err(RobotError::Verification(out.check.problems.clone()));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::coarse_to_fine;
+
+    #[test]
+    fn coarse_to_fine_finds_the_exact_boundaries_of_an_interval() {
+        // Feasible exactly on 7..=23 of 0..40: the result must equal the brute-force scan.
+        for (lo, hi) in [(7usize, 23usize), (0, 39), (10, 10), (0, 3), (36, 39)] {
+            let f = |i: usize| (lo..=hi).contains(&i);
+            let got = coarse_to_fine(40, 5, &f);
+            let want: Vec<bool> = (0..40).map(f).collect();
+            assert_eq!(got, want, "{lo}..={hi}");
+        }
+        // Nothing feasible; and, as documented, a run narrower than the stride between two
+        // infeasible coarse points is not seen.
+        assert!(coarse_to_fine(40, 5, &|_| false).iter().all(|v| !v));
+        assert!(
+            coarse_to_fine(40, 5, &|i| (12..=13).contains(&i))
+                .iter()
+                .all(|v| !v)
+        );
+    }
 }

@@ -401,3 +401,53 @@ fn tracked_program_poses_land_on_the_targets() {
     // < 0.2 m of travel): 1e-6 m would mean a wrong frame, sign or start travel.
     assert!(worst <= 1e-6, "{worst:e} m");
 }
+
+#[test]
+fn base_mode_and_settings_parse_with_defaults() {
+    let m: moving::BaseMode =
+        serde_json::from_str(r#"{"mode": "moving", "speed_max": 0.2}"#).unwrap();
+    match m {
+        moving::BaseMode::Moving(b) => {
+            assert_eq!(b.speed_max, 0.2);
+            assert_eq!(b.accel_max, MovingBase::default().accel_max);
+        }
+        other => panic!("{other:?}"),
+    }
+    let s: moving::BaseMode = serde_json::from_str(r#"{"mode": "stations"}"#).unwrap();
+    assert_eq!(s, moving::BaseMode::Stations);
+    assert!(serde_json::from_str::<moving::BaseMode>(r#"{"mode": "moving", "speed": 1}"#).is_err());
+}
+
+#[test]
+fn base_trajectory_rates_and_round_trip() {
+    // Rest, 0.1 m in 1 s, another 0.1 m in 1 s, then a 1 s hold: speeds 0.1, 0.1, 0; the
+    // accelerations at the rows are 0.1/0.5 (from rest over half a segment), 0, 0.1/1 (into
+    // the hold) and 0 (the hold ends at rest). Exact up to round-off (1e-12).
+    let mk = |t: f64, y: f64| BaseSample {
+        t,
+        base_x: 0.0,
+        base_y: y,
+        base_yaw: 0.5,
+        travel: y,
+    };
+    let tr = BaseTrajectory {
+        z: 0.0,
+        direction: [0.0, 1.0, 0.0],
+        samples: vec![mk(0.0, 0.0), mk(1.0, 0.1), mk(2.0, 0.2), mk(3.0, 0.2)],
+    };
+    let v = tr.speeds();
+    let a = tr.accelerations();
+    let close = |x: &[f64], y: &[f64]| {
+        x.len() == y.len() && x.iter().zip(y).all(|(p, q)| (p - q).abs() < 1e-12)
+    };
+    assert!(close(&v, &[0.1, 0.1, 0.0]), "{v:?}");
+    assert!(close(&a, &[0.2, 0.0, 0.1, 0.0]), "{a:?}");
+    let mid = tr.pose_at(1.5);
+    assert!((mid.t.y - 0.15).abs() < 1e-12);
+    let back = BaseTrajectory::from_csv(&tr.to_csv(), 0.0).unwrap();
+    assert_eq!(back.samples, tr.samples);
+    let s = tr.summary();
+    assert!((s.travel - 0.2).abs() < 1e-12 && (s.hold_time - 1.0).abs() < 1e-12);
+    let j: serde_json::Value = serde_json::from_str(&tr.to_json()).unwrap();
+    assert_eq!(j["samples"].as_array().unwrap().len(), 4);
+}
