@@ -9,7 +9,9 @@
 //! - joint targets beyond UR's position limits (±360°, elbow ±180°), poses and joint lists that
 //!   do not have six numbers;
 //! - I/O numbers the controller lacks, analog values outside 0..1, negative sleeps;
-//! - more motion targets than the limit.
+//! - more motion targets than the limit;
+//! - in a program that uses conveyor tracking (a moving base, [`crate::conveyor`]): a decoder
+//!   set up before tracking, no joint target while tracking, tracking stopped before the end.
 //!
 //! Hand-written: no URScript parser exists as a crate. The grammar covered is the subset the
 //! exporter and hand edits use (no operator precedence is needed to check literals and calls).
@@ -827,6 +829,10 @@ pub fn lint_with_limits(text: &str, max_targets: usize, limits: &[[f64; 2]; 6]) 
             "{} motion targets, more than the limit {max_targets}",
             rep.targets
         ));
+    }
+    // A moving-base program (conveyor tracking) has its own form (`crate::conveyor`).
+    if crate::conveyor::uses_tracking(text) {
+        problems.extend(crate::conveyor::tracking_form_problems(text));
     }
     let n = problems.len();
     if n > 50 {

@@ -451,3 +451,23 @@ fn base_trajectory_rates_and_round_trip() {
     let j: serde_json::Value = serde_json::from_str(&tr.to_json()).unwrap();
     assert_eq!(j["samples"].as_array().unwrap().len(), 4);
 }
+
+#[test]
+fn the_plain_lint_checks_the_tracking_form_too() {
+    // `kappe robot lint` calls lint_with_limits: a tracking program is held to its form there.
+    let mp = planned();
+    let o = &mp.plan.options;
+    let files = tracking_program_files(mp, &ConveyorOptions::default(), "part_").unwrap();
+    let text = &files[0].0.text;
+    let limits = o.limits.position();
+    assert!(lint_with_limits(text, 1000, &limits).ok());
+    let stop = text
+        .lines()
+        .find(|l| l.contains("stop_conveyor_tracking"))
+        .unwrap();
+    let rep = lint_with_limits(&text.replacen(stop, "", 1), 1000, &limits);
+    assert!(rep.problems.iter().any(|p| p.contains("never stopped")));
+    // Station programs are untouched by the tracking rules.
+    let station = program_files(&mp.plan, "x").unwrap();
+    assert!(lint_with_limits(&station[0].text, 1000, &limits).ok());
+}
