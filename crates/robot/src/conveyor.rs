@@ -171,6 +171,7 @@ pub fn tracking_program_files(
     prefix: &str,
 ) -> Result<Vec<(ProgramFile, TrackingStart)>, RobotError> {
     conveyor.validate()?;
+    mp.validate_shape()?;
     if !mp.check.problems.is_empty() {
         return Err(RobotError::Verification(mp.check.problems.clone()));
     }

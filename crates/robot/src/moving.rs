@@ -225,6 +225,64 @@ pub struct MovingPlan {
 }
 
 impl MovingPlan {
+    /// Check the plan's shape (it may come from a file): one station, a travel per waypoint,
+    /// program parts inside the layers, a non-empty time-ordered finite base trajectory. The
+    /// error names the field.
+    pub fn validate_shape(&self) -> Result<(), RobotError> {
+        let bad = |field: &str, m: String| Err(RobotError::invalid(field, m));
+        let [st] = self.plan.stations.as_slice() else {
+            return bad(
+                "plan.stations",
+                format!(
+                    "a moving plan has exactly one station, found {}",
+                    self.plan.stations.len()
+                ),
+            );
+        };
+        if st.layers.is_empty() || st.layers.iter().any(|l| l.waypoints.is_empty()) {
+            return bad("plan.stations[0].layers", "an empty layer or none".into());
+        }
+        if self.travel.len() != st.layers.len()
+            || self
+                .travel
+                .iter()
+                .zip(&st.layers)
+                .any(|(t, l)| t.len() != l.waypoints.len() || t.iter().any(|v| !v.is_finite()))
+        {
+            return bad(
+                "travel",
+                "needs one finite travel per waypoint of every layer".into(),
+            );
+        }
+        for (i, p) in self.plan.parts.iter().enumerate() {
+            if p.station != 0 || p.first > p.last || p.last >= st.layers.len() {
+                return bad(
+                    &format!("plan.parts[{i}]"),
+                    format!(
+                        "station {} layers {}..={}: must be station 0 and inside its {} layers",
+                        p.station,
+                        p.first,
+                        p.last,
+                        st.layers.len()
+                    ),
+                );
+            }
+        }
+        let s = &self.trajectory.samples;
+        let finite = s.iter().all(|x| {
+            [x.t, x.base_x, x.base_y, x.base_yaw, x.travel]
+                .iter()
+                .all(|v| v.is_finite())
+        });
+        if s.is_empty() || !finite || s.windows(2).any(|w| w[1].t < w[0].t) {
+            return bad(
+                "trajectory.samples",
+                "needs at least one sample, finite values and non-decreasing times".into(),
+            );
+        }
+        Ok(())
+    }
+
     /// The base pose (world) at waypoint `k` of layer slot `li`.
     pub fn base_pose(&self, li: usize, k: usize) -> Iso {
         let s = self
@@ -921,6 +979,10 @@ pub fn check_moving(mp: &MovingPlan) -> MovingCheck {
         min_self_distance: f64::INFINITY,
         ..Default::default()
     };
+    if let Err(e) = mp.validate_shape() {
+        rep.problems.push(e.to_string());
+        return rep;
+    }
     let plan = &mp.plan;
     let layers = crate::check::plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
@@ -1160,6 +1222,7 @@ fn certify_step(
 /// programs cut again and everything re-timed from 0 (approach and priming with the base
 /// standing at that layer's start), the base trajectory rebuilt and the result re-checked.
 pub fn resume_moving(mp: &MovingPlan, layer: i64) -> Result<MovingPlan, RobotError> {
+    mp.validate_shape()?;
     let plan = crate::program::resume_plan(&mp.plan, layer)?;
     let dropped = mp.plan.stations[0].layers.len() - plan.stations[0].layers.len();
     let travel: Vec<Vec<f64>> = mp.travel[dropped..].to_vec();

@@ -261,6 +261,7 @@ pub fn simulate_tracking(
     tol: &TrackingTolerance,
 ) -> Result<TrackingReport, RobotError> {
     errors.validate()?;
+    mp.validate_shape()?;
     if !(tol.max_deviation.is_finite() && tol.max_deviation > 0.0) {
         return Err(RobotError::invalid(
             "tracking.max_deviation",

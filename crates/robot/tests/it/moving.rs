@@ -471,3 +471,28 @@ fn the_plain_lint_checks_the_tracking_form_too() {
     let station = program_files(&mp.plan, "x").unwrap();
     assert!(lint_with_limits(&station[0].text, 1000, &limits).ok());
 }
+
+#[test]
+fn a_moving_plan_read_from_a_file_is_checked_before_use() {
+    // A plan whose travel does not match its waypoints (edited or truncated file) gives a named
+    // error from every consumer instead of an index panic.
+    let mut mp = planned().clone();
+    mp.travel.pop();
+    let e = tracking_program_files(&mp, &ConveyorOptions::default(), "x");
+    assert!(matches!(e, Err(RobotError::Invalid { field, .. }) if field == "travel"));
+    let e = simulate_tracking(
+        &mp,
+        &TrackingErrors::default(),
+        &TrackingTolerance::default(),
+    );
+    assert!(matches!(e, Err(RobotError::Invalid { field, .. }) if field == "travel"));
+    assert!(matches!(
+        resume_moving(&mp, 3),
+        Err(RobotError::Invalid { .. })
+    ));
+    assert!(!check_moving(&mp).problems.is_empty());
+    // A JSON round trip keeps a valid plan valid.
+    let back: MovingPlan =
+        serde_json::from_str(&serde_json::to_string(planned()).unwrap()).unwrap();
+    assert!(check_moving(&back).problems.is_empty());
+}
