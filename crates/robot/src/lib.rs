@@ -41,7 +41,8 @@ pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
 pub use lint::{LintReport, lint, lint_with_limits};
 pub use moving::{
-    BaseMode, MovingBase, MovingCheck, MovingPlan, check_moving, plan_moving, resume_moving,
+    BaseMode, MovingBase, MovingCheck, MovingPlan, check_moving, check_moving_tolerance,
+    plan_moving, resume_moving,
 };
 pub use plan::{
     CertifiedClearance, LayerPlan, Plan, Station, Waypoint, plan_print, plan_print_with_waits,

@@ -1244,6 +1244,141 @@ pub fn resume_moving(mp: &MovingPlan, layer: i64) -> Result<MovingPlan, RobotErr
     Ok(out)
 }
 
+/// The plan's feasibility under base-pose errors (as [`crate::tolerance::check_base_tolerance`]
+/// for stations): at every `stride`-th waypoint of every layer (and its last), with the base off
+/// its planned pose at that instant by each sampled error `(dx, dy, dyaw)`
+/// ([`crate::tolerance::sampled_errors`]: the corners of the box and its centre), a valid
+/// configuration on the planned elbow/wrist branch must exist (the planner's own acceptance,
+/// the body included), consecutive re-solved ones within ε·stride², and the body clear of the
+/// obstacles at each layer's start. Corners suffice for small errors (the clearances are then
+/// affine in the error, minimised at a corner; see `tolerance`).
+pub fn check_moving_tolerance(
+    mp: &MovingPlan,
+    tol: &crate::tolerance::BaseTolerance,
+) -> crate::tolerance::ToleranceReport {
+    use crate::tolerance::{ToleranceReport, sampled_errors};
+    let mut rep = ToleranceReport {
+        tolerance: tol.clone(),
+        min_clearance: f64::INFINITY,
+        ..Default::default()
+    };
+    let ok = tol.position.is_finite()
+        && tol.position >= 0.0
+        && tol.yaw_deg.is_finite()
+        && tol.yaw_deg >= 0.0
+        && tol.stride > 0;
+    if !ok {
+        rep.problems.push(format!(
+            "base tolerance position {} m, yaw {}°, stride {}: need finite values ≥ 0 and stride ≥ 1",
+            tol.position, tol.yaw_deg, tol.stride
+        ));
+        return rep;
+    }
+    if let Err(e) = mp.validate_shape() {
+        rep.problems.push(e.to_string());
+        return rep;
+    }
+    let plan = &mp.plan;
+    let layers = crate::check::plan_layers(plan);
+    let ctx = match validate(&layers, &plan.setup, &plan.options) {
+        Ok(c) => c,
+        Err(e) => {
+            rep.problems.push(format!("invalid plan input: {e}"));
+            return rep;
+        }
+    };
+    let geo = match Geometry::new(&ctx) {
+        Ok(g) => g,
+        Err(e) => {
+            rep.problems.push(format!("scene: {e}"));
+            return rep;
+        }
+    };
+    let errors = sampled_errors(tol);
+    rep.poses_per_station = errors.len();
+    let st = &plan.stations[0];
+    let eps = plan.options.epsilon;
+    let jobs: Vec<(usize, (f64, f64, f64))> = (0..st.layers.len())
+        .flat_map(|li| errors.iter().map(move |e| (li, *e)))
+        .collect();
+    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
+    let results: Vec<(usize, f64, Vec<String>)> = jobs
+        .par_iter()
+        .map(|&(li, (dx, dy, da))| {
+            let (mut n, mut min_c, mut pr) = (0usize, f64::INFINITY, Vec::new());
+            let l = &st.layers[li];
+            let off = |k: usize| {
+                Iso::translation(dx, dy, 0.0)
+                    .mul(&mp.base_pose(li, k))
+                    .mul(&Iso::rot_z(da))
+            };
+            let at = format!(
+                "layer {}, base off by ({:+.1} mm, {:+.1} mm, {:+.2}°)",
+                l.layer,
+                dx * 1e3,
+                dy * 1e3,
+                da.to_degrees()
+            );
+            if let Err(e) = ctx.check_base(&off(0)) {
+                pr.push(format!("{at}: {e}"));
+            }
+            let len = l.waypoints.len();
+            let mut prev: Option<Joints> = None;
+            for (k, w) in l.waypoints.iter().enumerate() {
+                if k % tol.stride != 0 && k + 1 != len {
+                    continue;
+                }
+                n += 1;
+                let (verts, rej) = geo.vertices(&off(k), li, k);
+                let best = verts
+                    .iter()
+                    .filter(|v| branch(&v.q) == branch(&w.q))
+                    .map(|v| {
+                        let d2: f64 = joint_delta(&w.q, &v.q).iter().map(|d| d * d).sum();
+                        (d2, v)
+                    })
+                    .min_by(|a, b| a.0.total_cmp(&b.0));
+                match best {
+                    None => {
+                        pr.push(format!(
+                            "{at}: point {} has no valid configuration on the planned branch ({})",
+                            w.index,
+                            rej.failure().1
+                        ));
+                        prev = None;
+                    }
+                    Some((_, v)) => {
+                        min_c = min_c.min(v.clearance);
+                        if let Some(p) = prev {
+                            let step: f64 = joint_delta(&p, &v.q).iter().map(|d| d * d).sum();
+                            let allowed = eps * (tol.stride.min(len) as f64).powi(2);
+                            if step > allowed {
+                                pr.push(format!(
+                                    "{at}: point {}: the re-solved joints jump by Σ Δq² = {step:.4} rad² (> {allowed:.4})",
+                                    w.index
+                                ));
+                            }
+                        }
+                        prev = Some(v.q);
+                    }
+                }
+            }
+            (n, min_c, pr)
+        })
+        .collect();
+    for (n, c, pr) in results {
+        rep.waypoints_checked += n;
+        rep.min_clearance = rep.min_clearance.min(c);
+        rep.problems.extend(pr);
+    }
+    let n = rep.problems.len();
+    if n > 20 {
+        rep.problems.truncate(20);
+        rep.problems.push(format!("… and {} more", n - 20));
+    }
+    rep
+}
+
 #[cfg(test)]
 mod tests {
     use super::coarse_to_fine;

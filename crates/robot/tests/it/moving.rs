@@ -496,3 +496,25 @@ fn a_moving_plan_read_from_a_file_is_checked_before_use() {
         serde_json::from_str(&serde_json::to_string(planned()).unwrap()).unwrap();
     assert!(check_moving(&back).problems.is_empty());
 }
+
+#[test]
+fn the_plan_tolerates_the_anchor_base_errors() {
+    // The anchor's largest base error (9.9 mm → 10 mm) in x and y and a 1° heading error, at
+    // every 4th waypoint: every target keeps a valid configuration on its branch.
+    let mp = planned();
+    let tol = kappe_robot::tolerance::BaseTolerance {
+        position: 0.010,
+        yaw_deg: 1.0,
+        stride: 4,
+    };
+    let rep = check_moving_tolerance(mp, &tol);
+    assert!(rep.problems.is_empty(), "{:?}", rep.problems);
+    assert_eq!(rep.poses_per_station, 9);
+    assert!(rep.min_clearance >= mp.plan.options.clearance);
+    // A 0.6 m error cannot be tolerated (the lead's reach margin is smaller): the check fails.
+    let far = kappe_robot::tolerance::BaseTolerance {
+        position: 0.6,
+        ..tol
+    };
+    assert!(!check_moving_tolerance(mp, &far).problems.is_empty());
+}
