@@ -2,7 +2,9 @@
 //! mobile base creeping along the beams while the arm prints each arch.
 //!
 //! **Base path.** A straight line along the bay axis (world +y, the direction in which the
-//! printing front advances; method.md §1) at a fixed lateral position `x`, height `z` and yaw
+//! printing front advances, method.md §1; −y when the front advances that way, as in the mirrored
+//! half of a `both_walls` bay: then every along-bay position is taken as −y and the heading
+//! `yaw_deg` is reflected to −yaw_deg, as the mirrored station search does) at a fixed lateral position `x`, height `z` and yaw
 //! `yaw_deg` (default x = 0, yaw 270°, z = 0: the pose family of the station search,
 //! [`crate::setup::BaseSearch`]). Only the along-bay position moves, which is what UR's linear
 //! conveyor tracking compensates ([`crate::conveyor`]).
@@ -210,7 +212,8 @@ pub struct MovingPlan {
     /// The arm's plan on the one clock: one station whose `world_from_base` is the base pose at
     /// travel 0 (the first target's); waypoints, times, parts, slowdowns as for stations.
     pub plan: Plan,
-    /// The settings used, with the lead resolved.
+    /// The settings used, with the lead resolved (and the heading reflected for a front that
+    /// advances along −y).
     pub base: MovingBase,
     /// Lead of the base ahead of the printing front (m).
     pub lead: f64,
@@ -374,25 +377,12 @@ pub struct MovingCheck {
 
 /// Along-bay front position per layer (mean y, running max) and per-waypoint progress offsets
 /// `f_o + (f_{o+1} − f_o)·c_k/L_o` (module docs).
-fn front_offsets(layers: &[PrintLayer]) -> Result<Vec<Vec<f64>>, RobotError> {
+fn front_offsets(layers: &[PrintLayer], sign: f64) -> Vec<Vec<f64>> {
     let mut front: Vec<f64> = Vec::with_capacity(layers.len());
     for l in layers {
-        let m = l.points.iter().map(|p| p.position[1]).sum::<f64>() / l.points.len() as f64;
+        let m = sign * l.points.iter().map(|p| p.position[1]).sum::<f64>() / l.points.len() as f64;
         let f = front.last().map_or(m, |&prev: &f64| prev.max(m));
         front.push(f);
-    }
-    if let (Some(a), Some(b)) = (front.first(), layers.last())
-        && layers.len() > 1
-    {
-        let last_mean = b.points.iter().map(|p| p.position[1]).sum::<f64>() / b.points.len() as f64;
-        if last_mean < *a {
-            return Err(RobotError::invalid(
-                "layers",
-                format!(
-                    "the printing front goes back along the bay (first layer at y = {a:.3} m, last at {last_mean:.3} m): a moving base follows a front that advances along +y"
-                ),
-            ));
-        }
     }
     let n = layers.len();
     let mut out = Vec::with_capacity(n);
@@ -422,7 +412,18 @@ fn front_offsets(layers: &[PrintLayer]) -> Result<Vec<Vec<f64>>, RobotError> {
                 .collect(),
         );
     }
-    Ok(out)
+    out
+}
+
+/// +1 when the printing front advances along +y (the last layer's mean y ≥ the first's), else −1.
+fn front_sign(layers: &[PrintLayer]) -> f64 {
+    let mean = |l: &PrintLayer| {
+        l.points.iter().map(|p| p.position[1]).sum::<f64>() / l.points.len().max(1) as f64
+    };
+    match (layers.first(), layers.last()) {
+        (Some(a), Some(b)) if mean(b) < mean(a) => -1.0,
+        _ => 1.0,
+    }
 }
 
 /// World geometry shared by the rungs: the context without the mobile-base body (the body moves
@@ -510,14 +511,22 @@ pub fn plan_moving(
     base.validate()?;
     let ctx = validate(layers, setup, opts)?;
     let geo = Geometry::new(&ctx)?;
-    let offsets = front_offsets(&ctx.layers)?;
+    // A front advancing along −y (a mirrored bay) is the mirror image: positions along the bay
+    // are measured as u = sign·y and the heading is reflected.
+    let sign = front_sign(&ctx.layers);
+    let eff = MovingBase {
+        yaw_deg: sign * base.yaw_deg,
+        ..base.clone()
+    };
+    let base = &eff;
+    let offsets = front_offsets(&ctx.layers, sign);
     let leads: Vec<(f64, Option<f64>)> = match base.lead {
         Some(l) => vec![(l, None)],
-        None => search_leads(&geo, &|w| ctx.check_base(w).is_ok(), &offsets, base)?,
+        None => search_leads(&geo, &|w| ctx.check_base(w).is_ok(), &offsets, base, sign)?,
     };
     let mut last_err: Option<RobotError> = None;
     for &(lead, margin) in leads.iter().take(4) {
-        match plan_with_lead(&ctx, &geo, &offsets, base, lead, margin, waits) {
+        match plan_with_lead(&ctx, &geo, (&offsets, sign), base, lead, margin, waits) {
             Ok(p) => return Ok(p),
             Err(e) => last_err = Some(e),
         }
@@ -532,6 +541,7 @@ fn search_leads(
     body_ok: &(dyn Fn(&Iso) -> bool + Sync),
     offsets: &[Vec<f64>],
     base: &MovingBase,
+    sign: f64,
 ) -> Result<Vec<(f64, Option<f64>)>, RobotError> {
     let [lo, hi] = base.lead_range;
     let n = (((hi - lo) / base.lead_step).floor() as usize).min(2000);
@@ -555,10 +565,10 @@ fn search_leads(
     let eval = |lead: f64| {
         sample_layers
             .iter()
-            .all(|&o| body_ok(&base.pose_at(lead + offsets[o][0])))
+            .all(|&o| body_ok(&base.pose_at(sign * (lead + offsets[o][0]))))
             && samples
                 .iter()
-                .all(|&(o, k)| geo.reachable(&base.pose_at(lead + offsets[o][k]), o, k))
+                .all(|&(o, k)| geo.reachable(&base.pose_at(sign * (lead + offsets[o][k])), o, k))
     };
     let feasible = coarse_to_fine(cands.len(), COARSE, &|i| eval(cands[i]));
     // Grid steps to the nearest infeasible lead (the grid's ends count as infeasible beyond).
@@ -660,15 +670,17 @@ fn coarse_to_fine(m: usize, coarse: usize, eval: &(dyn Fn(usize) -> bool + Sync)
     out
 }
 
+/// `along`: the per-target front offsets and the direction sign (u = sign·y).
 fn plan_with_lead(
     ctx: &Context,
     geo: &Geometry,
-    offsets: &[Vec<f64>],
+    along: (&[Vec<f64>], f64),
     base: &MovingBase,
     lead: f64,
     margin: Option<f64>,
     waits: Option<&[LayerWait]>,
 ) -> Result<MovingPlan, RobotError> {
+    let (offsets, sign) = along;
     let fail = |o: usize, k: usize, kind: FailureKind, detail: String| {
         RobotError::Unplannable(Box::new(PlanFailure {
             station: 0,
@@ -679,7 +691,7 @@ fn plan_with_lead(
         }))
     };
     let y0 = lead + offsets[0][0];
-    let start = base.pose_at(y0);
+    let start = base.pose_at(sign * y0);
     // The body along the base path (every body_check_step of travel and at both ends).
     let y1 = lead
         + offsets
@@ -690,12 +702,16 @@ fn plan_with_lead(
     let nb = ((y1 - y0) / base.body_check_step).ceil().max(0.0) as usize;
     for i in 0..=nb {
         let y = (y0 + i as f64 * base.body_check_step).min(y1);
-        if let Err(e) = ctx.check_base(&base.pose_at(y)) {
+        if let Err(e) = ctx.check_base(&base.pose_at(sign * y)) {
             return Err(fail(
                 0,
                 0,
                 FailureKind::BasePlacement,
-                format!("base at y = {y:.3} m (travel {:.3} m): {e}", y - y0),
+                format!(
+                    "base at y = {:.3} m (travel {:.3} m): {e}",
+                    sign * y,
+                    y - y0
+                ),
             ));
         }
     }
@@ -704,7 +720,7 @@ fn plan_with_lead(
         .collect();
     let built: Vec<(Vec<Vertex>, crate::plan::Rejections)> = rung_ids
         .par_iter()
-        .map(|&(o, k)| geo.vertices(&base.pose_at(lead + offsets[o][k]), o, k))
+        .map(|&(o, k)| geo.vertices(&base.pose_at(sign * (lead + offsets[o][k])), o, k))
         .collect();
     let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
@@ -867,7 +883,7 @@ fn plan_with_lead(
         ..base.clone()
     };
     let mut mp = MovingPlan {
-        trajectory: base_trajectory(&plan, &travel, &start, base),
+        trajectory: base_trajectory(&plan, &travel, &start, base, DVec3::Y * sign),
         plan,
         base: resolved,
         lead,
@@ -891,8 +907,8 @@ fn base_trajectory(
     travel: &[Vec<f64>],
     start: &Iso,
     base: &MovingBase,
+    dir: DVec3,
 ) -> BaseTrajectory {
-    let dir = DVec3::Y;
     let yaw = base.yaw_deg.to_radians();
     let mut samples = Vec::new();
     let sample = |t: f64, s: f64| {
@@ -1228,7 +1244,13 @@ pub fn resume_moving(mp: &MovingPlan, layer: i64) -> Result<MovingPlan, RobotErr
     let travel: Vec<Vec<f64>> = mp.travel[dropped..].to_vec();
     let start = Iso::from_mat4_unchecked(&mp.plan.stations[0].world_from_base);
     let mut out = MovingPlan {
-        trajectory: base_trajectory(&plan, &travel, &start, &mp.base),
+        trajectory: base_trajectory(
+            &plan,
+            &travel,
+            &start,
+            &mp.base,
+            DVec3::from(mp.trajectory.direction),
+        ),
         plan,
         base: mp.base.clone(),
         lead: mp.lead,

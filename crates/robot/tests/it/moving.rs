@@ -307,13 +307,6 @@ fn bad_inputs_give_named_errors() {
     });
     assert_eq!(f, "moving.speed_max");
     assert!(m.contains("keep up"), "{m}");
-    // A front that goes back along the bay.
-    let mut rev = layers.clone();
-    rev.reverse();
-    match plan_moving(&rev, &setup, &opts, &MovingBase::default(), None) {
-        Err(RobotError::Invalid { field, .. }) => assert_eq!(field, "layers"),
-        other => panic!("{other:?}"),
-    }
     // The default 0.8 m span in a bay whose beams run 3 m ahead of the print: the 0.82 m wide
     // RB-Vogui body cannot drive between them, nor reach the print from beyond their end.
     let small = cap_path(0.8, 0.2, 25.0, 0.008, 12, 12);
@@ -517,4 +510,34 @@ fn the_plan_tolerates_the_anchor_base_errors() {
         ..tol
     };
     assert!(!check_moving_tolerance(mp, &far).problems.is_empty());
+}
+
+#[test]
+fn a_mirrored_bay_moves_the_base_along_minus_y() {
+    // The mirror image (y → −y) of the test print, as `kappe` plans the second half of a
+    // both-walls bay: the front advances along −y, so must the base.
+    let (mut layers, mut setup, opts) = inputs();
+    for p in layers.iter_mut().flat_map(|l| &mut l.points) {
+        p.position[1] = -p.position[1];
+        p.axis[1] = -p.axis[1];
+    }
+    for o in &mut setup.obstacles {
+        if let kappe_robot::collision::Obstacle::Box { center, .. } = o {
+            center[1] = -center[1];
+        }
+    }
+    let mp = plan_moving(&layers, &setup, &opts, &MovingBase::default(), None).unwrap();
+    assert_eq!(mp.trajectory.direction, [0.0, -1.0, 0.0]);
+    assert!(mp.check.problems.is_empty(), "{:?}", mp.check.problems);
+    // Acceptance 1e-6 m (as the +y test): FK composed with the base at each instant.
+    assert!(mp.check.max_position_error <= 1e-6);
+    let s = &mp.trajectory.samples;
+    assert!(s.last().unwrap().base_y < s[0].base_y - 0.1);
+    // The mirror of the +y plan: same lead, base y mirrored at the start (1e-9 m).
+    let plus = planned();
+    assert!((mp.lead - plus.lead).abs() < 1e-9);
+    assert!((s[0].base_y + plus.trajectory.samples[0].base_y).abs() < 1e-9);
+    let rep =
+        simulate_tracking(&mp, &TrackingErrors::none(), &TrackingTolerance::default()).unwrap();
+    assert!(rep.max_deviation <= 1e-6, "{}", rep.max_deviation);
 }
