@@ -1,12 +1,12 @@
 //! Printing while the base moves (issue 27): one continuous print along the whole bay, the
 //! mobile base creeping along the beams while the arm prints each arch.
 //!
-//! **Base path.** A straight line along the bay axis (world +y, the direction in which the
-//! printing front advances, method.md §1; −y when the front advances that way, as in the mirrored
-//! half of a `both_walls` bay: then every along-bay position is taken as −y and the heading
-//! `yaw_deg` is reflected to −yaw_deg, as the mirrored station search does) at a fixed lateral position `x`, height `z` and yaw
-//! `yaw_deg` (default x = 0, yaw 270°, z = 0: the pose family of the station search,
-//! [`crate::setup::BaseSearch`]). Only the along-bay position moves, which is what UR's linear
+//! **Base path.** A straight line along the bay axis at a fixed lateral position `x`, height `z`
+//! and yaw `yaw_deg` (default x = 0, yaw 270°, z = 0: the pose family of the station search,
+//! [`crate::setup::BaseSearch`]). The axis is world +y, the direction in which the printing front
+//! advances (method.md §1), or −y when the front advances that way (the mirrored half of a
+//! `both_walls` bay): then every along-bay position is taken as −y and the heading is reflected
+//! to −yaw_deg, as the mirrored station search does. Only the along-bay position moves, which is what UR's linear
 //! conveyor tracking compensates ([`crate::conveyor`]).
 //!
 //! **Base position tied to path progress.** Let `f_o` be the printing front of layer o: the mean
@@ -35,8 +35,9 @@
 //! scored on a sample of the print (`score_layers` layers spread over it, every `score_stride`-th
 //! target and each layer's last): a lead is feasible when every sampled target has a valid
 //! configuration (the planner's own acceptance: limits, singularity margins, self-collision,
-//! clearance to beams, floor and printed layers; the grid is scanned every 5th lead and each
-//! feasibility boundary bisected, [`coarse_to_fine`]). Among the feasible leads the one farthest
+//! clearance to beams, floor and printed layers) and the base body clears the beams at every
+//! sampled layer's start (the grid is scanned every 5th lead and each
+//! feasibility boundary bisected, `coarse_to_fine`). Among the feasible leads the one farthest
 //! (in grid steps) from any infeasible lead is taken: its **reach margin**, how far the base may be
 //! off along the bay before a sampled target becomes unreachable, is `(m − 1)·lead_step` for
 //! m steps to the nearest infeasible lead (the boundary lies somewhere in the last step).
@@ -52,9 +53,8 @@
 //! the arm depends on the joints only). The body against the static obstacles and the print is
 //! checked at base poses every `body_check_step` of travel.
 //!
-//! Sources: the RB-Vogui XL's drive (robot.md §5: omnidirectional, 4 steered wheels). Robotnik
-//! publishes no creep-speed or acceleration limits for printing; the defaults below are
-//! assumptions, far above what a creeping base needs (< 1 mm/s) and far below the platform's
+//! Sources: the RB-Vogui XL's drive (robot.md §5: omnidirectional, 4 steered wheels). No
+//! published creep-speed or acceleration limits were found; the defaults below are assumptions, far above what a creeping base needs (< 1 mm/s) and far below the platform's
 //! driving speed, so they only catch a path the base cannot follow.
 
 use parry3d_f64::glamx::DVec3;
