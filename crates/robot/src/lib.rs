@@ -9,8 +9,10 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod base;
+pub mod base_trajectory;
 pub mod check;
 pub mod collision;
+pub mod conveyor;
 pub mod error;
 pub mod export;
 pub mod files;
@@ -19,6 +21,7 @@ pub mod kinematics;
 pub mod ladder;
 pub mod lint;
 pub mod meshes;
+pub mod moving;
 pub mod plan;
 pub mod program;
 pub mod setup;
@@ -27,13 +30,20 @@ pub mod sweep;
 pub mod synthetic;
 pub mod timing;
 pub mod tolerance;
+pub mod tracking;
 
+pub use base_trajectory::{BaseSample, BaseSummary, BaseTrajectory};
 pub use check::{CheckReport, check_plan};
+pub use conveyor::{ConveyorOptions, lint_tracking, tracking_index_json, tracking_program_files};
 pub use error::{FailureKind, PlanFailure, RobotError};
 pub use export::{urscript_programs, write_plan_json, write_trajectory_csv, write_urscript};
 pub use frames::{Iso, Mat4};
 pub use kinematics::{Dh, IkSolutions, Joints, UR10E};
 pub use lint::{LintReport, lint, lint_with_limits};
+pub use moving::{
+    BaseMode, MovingBase, MovingCheck, MovingPlan, check_moving, check_moving_tolerance,
+    plan_moving, resume_moving,
+};
 pub use plan::{
     CertifiedClearance, LayerPlan, Plan, Station, Waypoint, plan_print, plan_print_with_waits,
 };
@@ -43,3 +53,4 @@ pub use setup::{
     RobotSetup, Tool, ToolCapsule,
 };
 pub use timing::{LayerTime, LayerWait, Slowdown, apply_timing, layer_times, retime};
+pub use tracking::{TrackingErrors, TrackingReport, TrackingTolerance, simulate_tracking};

@@ -9,7 +9,9 @@
 //! - joint targets beyond UR's position limits (±360°, elbow ±180°), poses and joint lists that
 //!   do not have six numbers;
 //! - I/O numbers the controller lacks, analog values outside 0..1, negative sleeps;
-//! - more motion targets than the limit.
+//! - more motion targets than the limit;
+//! - in a program that uses conveyor tracking (a moving base, [`crate::conveyor`]): a decoder
+//!   set up before tracking, no joint target while tracking, tracking stopped before the end.
 //!
 //! Hand-written: no URScript parser exists as a crate. The grammar covered is the subset the
 //! exporter and hand edits use (no operator precedence is needed to check literals and calls).
@@ -141,6 +143,37 @@ pub const SIGNATURES: &[Signature] = &[
         name: "pose_inv",
         min: 1,
         params: &["p_from"],
+    },
+    // Conveyor tracking (a moving base's travel as the conveyor, `crate::conveyor`).
+    Signature {
+        name: "conveyor_pulse_decode",
+        min: 3,
+        params: &["type", "A", "B"],
+    },
+    Signature {
+        name: "encoder_enable_pulse_decode",
+        min: 4,
+        params: &["encoder_index", "decoder_type", "A", "B"],
+    },
+    Signature {
+        name: "track_conveyor_linear",
+        min: 2,
+        params: &["direction", "ticks_per_meter", "encoder_index"],
+    },
+    Signature {
+        name: "stop_conveyor_tracking",
+        min: 0,
+        params: &["a"],
+    },
+    Signature {
+        name: "end_conveyor_tracking",
+        min: 0,
+        params: &["a", "aRot"],
+    },
+    Signature {
+        name: "get_standard_digital_in",
+        min: 1,
+        params: &["n"],
     },
 ];
 
@@ -550,6 +583,57 @@ fn check_call(
                 ));
             }
         }
+        "conveyor_pulse_decode" => {
+            if let Some(t) = num(0)
+                && !(t.fract() == 0.0 && (0.0..=4.0).contains(&t))
+            {
+                problems.push(format!(
+                    "line {ln}: conveyor_pulse_decode(): type {t} (0 off, 1 quadrature, 2–4 single-input edges)"
+                ));
+            }
+            for i in [1, 2] {
+                if let Some(n) = num(i)
+                    && !(n.fract() == 0.0 && (0.0..=3.0).contains(&n))
+                {
+                    problems.push(format!(
+                        "line {ln}: conveyor_pulse_decode(): encoder input {n} does not exist (digital inputs 0–3)"
+                    ));
+                }
+            }
+        }
+        "track_conveyor_linear" => {
+            if let Some(e) = bound[0]
+                && let Some(p) = numbers(e)
+            {
+                let len = if p.len() == 6 {
+                    (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt()
+                } else {
+                    0.0
+                };
+                // 1e-6: the writer's 9 decimals on a unit vector.
+                if p.len() != 6 || (len - 1.0).abs() > 1e-6 || p[3..].iter().any(|v| *v != 0.0) {
+                    problems.push(format!(
+                        "line {ln}: track_conveyor_linear(): direction {p:?} must be p[x, y, z, 0, 0, 0] with a unit (x, y, z)"
+                    ));
+                }
+            }
+            if let Some(t) = num(1)
+                && t <= 0.0
+            {
+                problems.push(format!(
+                    "line {ln}: track_conveyor_linear(): ticks_per_meter {t} must be > 0"
+                ));
+            }
+        }
+        "get_standard_digital_in" => {
+            if let Some(n) = num(0)
+                && !(n.fract() == 0.0 && (0.0..=7.0).contains(&n))
+            {
+                problems.push(format!(
+                    "line {ln}: get_standard_digital_in(): input {n} does not exist (0..=7)"
+                ));
+            }
+        }
         "sleep" => {
             if let Some(t) = num(0)
                 && t < 0.0
@@ -745,6 +829,10 @@ pub fn lint_with_limits(text: &str, max_targets: usize, limits: &[[f64; 2]; 6]) 
             "{} motion targets, more than the limit {max_targets}",
             rep.targets
         ));
+    }
+    // A moving-base program (conveyor tracking) has its own form (`crate::conveyor`).
+    if crate::conveyor::uses_tracking(text) {
+        problems.extend(crate::conveyor::tracking_form_problems(text));
     }
     let n = problems.len();
     if n > 50 {

@@ -1037,7 +1037,7 @@ pub fn plan_print_with_waits(
     Ok(plan)
 }
 
-fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
+pub(crate) fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
     let mut cost = 0.0;
     let mut motion = 0.0;
     let mut min_c = f64::INFINITY;

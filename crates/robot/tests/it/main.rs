@@ -5,6 +5,7 @@ mod collision;
 mod common;
 mod kinematics;
 mod ladder;
+mod moving;
 mod plan;
 mod program;
 mod sweep;
