@@ -385,3 +385,80 @@ fn optimize_on_a_design_file_without_its_table_says_so() {
     assert!(!stderr(&o).contains("unknown field"), "{}", stderr(&o));
     assert!(!tmp.path().join("o").exists());
 }
+
+/// Issue 22: `kappe optimize` confirms its optimum with `kappe design`'s run and verdict, so
+/// `kappe design` of the design it writes passes whenever it reports a feasible optimum.
+#[test]
+fn kappe_design_passes_the_optimum_kappe_optimize_writes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args(["init", "opt.toml", "--kind", "optimize"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args([
+            "optimize",
+            "opt.toml",
+            "--out",
+            "o",
+            "--max-evaluations",
+            "4",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    // The example is feasible from its start design; a budget of 4 evaluations keeps it quick.
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args(["design", "o/design.toml", "--out", "d", "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(tmp.path().join("d/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["ok"], true);
+    assert_eq!(summary["failures"], serde_json::json!([]));
+}
+
+/// Issue 22: a `[schedule]` that does not fit the print is a named error and nothing is
+/// written (it used to vanish from `summary.json`).
+#[test]
+fn a_schedule_that_does_not_fit_the_print_is_a_named_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("d.toml"),
+        "[schedule]\nwaits = [1.0, 2.0, 3.0]\n",
+    )
+    .unwrap();
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args(["design", "d.toml", "--out", "o", "--no-robot"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("schedule.waits"), "{}", stderr(&o));
+    assert!(!tmp.path().join("o").exists());
+}
+
+/// Issue 22: an invalid time model is a named error before anything runs, nothing written.
+#[test]
+fn an_invalid_time_model_is_a_named_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("d.toml"),
+        "[material.time]\nmodel = \"linear\"\nyoungs_modulus_rate = -5.0\n",
+    )
+    .unwrap();
+    let o = kappe()
+        .current_dir(tmp.path())
+        .args(["design", "d.toml", "--out", "o", "--no-robot"])
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("material.time"), "{}", stderr(&o));
+    assert!(!tmp.path().join("o").exists());
+}

@@ -17,6 +17,8 @@
 //!
 //! [`class`] sorts every crate's errors for whoever reports them (exit status, exception).
 
+#![warn(missing_docs)]
+
 pub mod analysis;
 pub mod class;
 pub mod commands;

@@ -39,14 +39,7 @@ pub enum Outcome {
 }
 
 /// A design given by path (relative to the prototype file) or inline.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum DesignSource {
-    /// Path of a design TOML file.
-    Path(String),
-    /// An inline design table.
-    Inline(Box<Design>),
-}
+pub type DesignSource = crate::input::resolve::Source<Design>;
 
 /// One printed prototype.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -417,29 +410,29 @@ pub fn resolve_prototypes(
     file.prototypes
         .iter()
         .map(|p| {
-            let design = match &p.design {
-                DesignSource::Inline(d) => {
-                    d.validate().map_err(|source| SourceError::InlineDesign {
-                        name: p.name.clone(),
-                        source,
-                    })?;
-                    (**d).clone()
-                }
-                DesignSource::Path(rel) => {
-                    let path = base.join(rel);
-                    let text =
-                        std::fs::read_to_string(&path).map_err(|source| SourceError::Read {
-                            name: p.name.clone(),
-                            path: path.clone(),
-                            source,
-                        })?;
-                    Design::from_toml_str(&text).map_err(|source| SourceError::Design {
+            use crate::input::resolve::ResolveError;
+            let design = p
+                .design
+                .resolve(base, Design::validate, Design::from_toml_str)
+                .map_err(|e| match e {
+                    ResolveError::Read { path, source } => SourceError::Read {
                         name: p.name.clone(),
                         path,
                         source,
-                    })?
-                }
-            };
+                    },
+                    ResolveError::Invalid { path: None, source } => SourceError::InlineDesign {
+                        name: p.name.clone(),
+                        source,
+                    },
+                    ResolveError::Invalid {
+                        path: Some(path),
+                        source,
+                    } => SourceError::Design {
+                        name: p.name.clone(),
+                        path,
+                        source,
+                    },
+                })?;
             Ok(Resolved {
                 prototype: p.clone(),
                 design,

@@ -81,14 +81,7 @@ pub struct FitSpec {
 }
 
 /// The buildability spec of the prints: a path (relative to the calibration file) or inline.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
-pub enum SpecSource {
-    /// Path of a buildability spec.
-    Path(String),
-    /// Inline spec.
-    Inline(Box<BuildabilitySpec>),
-}
+pub type SpecSource = crate::input::resolve::Source<BuildabilitySpec>;
 
 /// One observed print.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -469,17 +462,16 @@ pub fn resolve_spec(
     base: &std::path::Path,
 ) -> Result<BuildabilitySpec, crate::commands::calibrate_blf::SourceError> {
     use crate::commands::calibrate_blf::SourceError;
-    match &file.buildability {
-        SpecSource::Inline(s) => Ok((**s).clone()),
-        SpecSource::Path(rel) => {
-            let path = base.join(rel);
-            let text = std::fs::read_to_string(&path).map_err(|source| SourceError::ReadSpec {
-                path: path.clone(),
+    use crate::input::resolve::ResolveError;
+    file.buildability
+        .resolve(base, |_| Ok(()), BuildabilitySpec::parse)
+        .map_err(|e| match e {
+            ResolveError::Read { path, source } => SourceError::ReadSpec { path, source },
+            ResolveError::Invalid { path, source } => SourceError::Spec {
+                path: path.unwrap_or_default(),
                 source,
-            })?;
-            BuildabilitySpec::parse(&text).map_err(|source| SourceError::Spec { path, source })
-        }
-    }
+            },
+        })
 }
 
 /// The calibration as the JSON document `kappe calibrate --json/--out` writes.

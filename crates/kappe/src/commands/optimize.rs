@@ -569,14 +569,18 @@ pub enum StartError {
     /// `design = "FILE"` cannot be read.
     #[error("cannot read the design file {}", path.display())]
     Read {
+        /// The file named.
         path: std::path::PathBuf,
+        /// What reading it said.
         #[source]
         source: std::io::Error,
     },
     /// `design = "FILE"` is not a valid design.
     #[error("invalid design file {}", path.display())]
     Invalid {
+        /// The file named.
         path: std::path::PathBuf,
+        /// What is wrong in it.
         #[source]
         source: DesignError,
     },
@@ -595,17 +599,18 @@ pub fn start_design(
     }
     Ok(match &file.design {
         None => Design::default(),
-        Some(DesignSource::Inline(d)) => {
-            d.validate().map_err(StartError::Inline)?;
-            (**d).clone()
-        }
-        Some(DesignSource::Path(rel)) => {
-            let path = base.join(rel);
-            let text = std::fs::read_to_string(&path).map_err(|source| StartError::Read {
-                path: path.clone(),
-                source,
-            })?;
-            Design::from_toml_str(&text).map_err(|source| StartError::Invalid { path, source })?
+        Some(source) => {
+            use crate::input::resolve::ResolveError;
+            source
+                .resolve(base, Design::validate, Design::from_toml_str)
+                .map_err(|e| match e {
+                    ResolveError::Read { path, source } => StartError::Read { path, source },
+                    ResolveError::Invalid { path: None, source } => StartError::Inline(source),
+                    ResolveError::Invalid {
+                        path: Some(path),
+                        source,
+                    } => StartError::Invalid { path, source },
+                })?
         }
     })
 }

@@ -152,18 +152,29 @@ impl Verdict {
 /// One design's results, as stored in `study.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Record {
+    /// Position in the study (0-based).
     pub index: usize,
+    /// The design's name.
     pub name: String,
     /// The value of each varied parameter, as text.
     pub parameters: Vec<String>,
+    /// Pass, fail, or could not run.
     pub outcome: Verdict,
+    /// Why it could not run.
     pub error: Option<String>,
+    /// Most compressive stress over all states, Pa.
     pub max_compression_stress_pa: Option<f64>,
+    /// Largest stress over all states, Pa.
     pub max_tension_stress_pa: Option<f64>,
+    /// Largest layer overhang, m.
     pub max_overhang_m: Option<f64>,
+    /// Lowest buckling factor over the analysed states.
     pub min_blf: Option<f64>,
+    /// Printed mass, kg.
     pub mass_kg: Option<f64>,
+    /// Print time, s.
     pub print_time_s: Option<f64>,
+    /// Print states.
     pub states: Option<usize>,
     /// `ok` or `failed: <reason>` when the robot was planned.
     pub robot: Option<String>,
@@ -176,15 +187,21 @@ pub struct Record {
 /// `study.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StudyResult {
+    /// Always `kappe.study`.
     pub format: String,
+    /// Format version.
     pub version: u32,
+    /// The study's title.
     pub title: String,
+    /// Hash of the study file, so shards of different studies are not merged.
     pub fingerprint: String,
     /// Every design name of the study, in study order (also those of other shards).
     pub designs: Vec<String>,
     /// `[i, n]` for a shard, absent for a whole study.
     pub shard: Option<[usize; 2]>,
+    /// The varied parameters (design file paths).
     pub parameters: Vec<String>,
+    /// One row per design.
     pub rows: Vec<Record>,
 }
 
