@@ -12,7 +12,7 @@ if [ ! -x "$venv/bin/python" ]; then
   "$python" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install -q --upgrade pip
-"$venv/bin/python" -m pip install -q "maturin>=1.9,<2" numpy "dask[distributed]" "compas>=2" pytest mypy ruff
+"$venv/bin/python" -m pip install -q "maturin>=1.9,<2" numpy "dask[distributed]" "compas>=2" pytest mypy ruff jsonschema types-jsonschema
 # Python code is typed and formatted (python/pyproject.toml: [tool.mypy], [tool.ruff]).
 (cd "$root/python" && "$venv/bin/ruff" format --check . && "$venv/bin/ruff" check . && "$venv/bin/mypy")
 wheels="$root/target/py-wheels"

@@ -93,3 +93,22 @@ def test_compas_round_trip(tmp_path):
     compas.json_dump(r, str(tmp_path / "r.json"))
     back = compas.json_load(str(tmp_path / "r.json"))
     assert isinstance(back, kappe.Result) and back.summary == r.summary
+
+
+def test_default_designs_summary_matches_its_published_schema(tmp_path, kappe_bin):
+    """Issue 22: summary.json of the default design (`kappe design`, robot and every state)
+    validates against docs/formats/summary.schema.json, the schema generated from the typed
+    summary; an output missing a required field or with a wrong type would fail here."""
+    import jsonschema
+
+    from conftest import ROOT
+
+    schema = json.loads((ROOT / "docs" / "formats" / "summary.schema.json").read_text())
+    out = tmp_path / "out"
+    subprocess.run([kappe_bin, "design", "--out", str(out), "-q", "--allow-fail"], check=True)
+    summary = json.loads((out / "summary.json").read_text())
+    jsonschema.validate(summary, schema)
+    # The check can fail: a summary without its verdict does not validate.
+    del summary["ok"]
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(summary, schema)

@@ -517,7 +517,15 @@ pub fn optimize_until(
     } = evaluate(&design, &file.verify);
     let feasible = verdict.as_ref().is_some_and(|v| v.ok);
     if let Some(v) = verdict.as_ref().filter(|v| !v.ok) {
-        failing = v.failures.iter().map(ToString::to_string).collect();
+        // Constraints by name (as the search reports them), other checks in words.
+        failing = v
+            .failures
+            .iter()
+            .map(|f| match f {
+                crate::verdict::Failure::Constraint { name, .. } => name.clone(),
+                other => other.to_string(),
+            })
+            .collect();
     }
     let binding = match &verification {
         Some(a) if feasible => a

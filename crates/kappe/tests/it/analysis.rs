@@ -298,16 +298,18 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
     // Lanczos tolerance of 1e-8 on μ.
     assert!((b2.factors[0] / b1.factors[0] - 2.0).abs() < 1e-6);
     // Ageing from E₀ = E with a positive rate stiffens older layers: BLF between E and E_max.
+    // `[analysis.ageing]` is read as the linear time model, and the layers are aged on the
+    // cap's one schedule (issue 22).
     let e = d.material.youngs_modulus;
-    let aged = AnalysisOptions {
-        ageing: Some(Ageing {
-            initial_modulus: e,
-            rate: e / 600.0,
-            max_modulus: Some(2.0 * e),
-        }),
-        ..AnalysisOptions::default()
-    };
-    let m = state_material(&c, &aged, last).unwrap();
+    let mut da = d.clone();
+    da.analysis.ageing = Some(Ageing {
+        initial_modulus: e,
+        rate: e / 600.0,
+        max_modulus: Some(2.0 * e),
+    });
+    let ca = cap(&da);
+    let aged = da.analysis.clone();
+    let m = state_material(&ca, &aged, last).unwrap();
     // The top layer is fresh, older ones stiffer, none above E_max.
     let top_id = c.sections.layers[last].id;
     assert_eq!(m.modulus_of(top_id), e);
