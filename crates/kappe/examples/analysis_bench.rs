@@ -40,7 +40,7 @@ fn profile(file: &str, states: &[usize]) -> Result<(), Box<dyn std::error::Error
         let t_stress = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let reduced = match &o.grading {
-            Some(g) => kappe::analysis::window::graded_state(&state, g),
+            Some(g) => kappe::analysis::graded::graded_state(&state, g),
             None => state.clone(),
         };
         let t_graded = t.elapsed().as_secs_f64();

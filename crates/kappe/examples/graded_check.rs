@@ -1,4 +1,4 @@
-//! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::analysis::window`).
+//! Graded shell meshes against the full analysis, state by state (issue 15, `kappe::analysis::graded`).
 //!
 //! `cargo run --release -p kappe --example graded_check -- LENGTH [FINE:MAX_STRIDE[:ZONE_ROWS[:TRANSVERSE[:START_STRIDE]]]] ...`
 //! (e.g. `1.2 32:32:8:4:1`; fields left out take the default grading's values; no grading given:
@@ -9,7 +9,7 @@
 //! `KAPPE_STATES=every:N` to check every N-th state only (long caps), `KAPPE_NO_FULL=1` to time
 //! the gradings alone.
 
-use kappe::analysis::window::Grading;
+use kappe::analysis::graded::Grading;
 use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
 use kappe::{Design, design_cap};
 

@@ -43,7 +43,7 @@ fn one(length: f64) -> Result<(), Box<dyn std::error::Error>> {
     } else {
         d.cap.end = kappe::form::ends::EndKind::EndWall;
     }
-    d.analysis.grading = Some(kappe::analysis::window::Grading::default());
+    d.analysis.grading = Some(kappe::analysis::graded::Grading::default());
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
     let cap = kappe::design_cap(&d, &|_| {})?;

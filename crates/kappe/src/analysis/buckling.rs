@@ -123,9 +123,9 @@ pub fn state_buckling_warm(
     options: &AnalysisOptions,
     guess: Option<&ModeGuess>,
 ) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
-    // A graded mesh (issue 15, `crate::analysis::window`) analyses the state reduced to its kept rows; the
+    // A graded mesh (issue 15, `crate::analysis::graded`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
-    let analysed = crate::analysis::window::AnalysedState::new(state, options.grading.as_ref());
+    let analysed = crate::analysis::graded::AnalysedState::new(state, options.grading.as_ref());
     let shell = match state_shell(analysed.state(), material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
@@ -236,7 +236,7 @@ fn shell_buckling_run(
         modes: options.modes,
         // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
         // modelling error and saves Lanczos steps over the default 1e-10. A graded mesh is
-        // itself an approximation (≤ 1 %, `crate::analysis::window`): there 1e-6 suffices, since a Ritz
+        // itself an approximation (≤ 1 %, `crate::analysis::graded`): there 1e-6 suffices, since a Ritz
         // value with relative residual r lies within r (and, given the gap to the next mode,
         // within ~r²) of an eigenvalue of the symmetric operator.
         tolerance: if options.grading.is_some() {

@@ -448,13 +448,13 @@ impl CapGreen {
     }
 
     /// Buckling, strength and bed-joint sliding of one cap state from one solve: the state's
-    /// shell (on the graded mesh of `options.grading` when set, `crate::analysis::window`) with
+    /// shell (on the graded mesh of `options.grading` when set, `crate::analysis::graded`) with
     /// `material` (E per layer already aged), its buckling solve, and the strength and sliding
     /// checks on that solve's static solution. The mode is keyed by the state's own network
     /// nodes either way. `None` without a strength model or without a shell (a single layer):
     /// the caller's plain buckling path then covers the state.
     ///
-    /// On a graded mesh ([`crate::analysis::window::Grading::for_stresses`]) an element spanning several
+    /// On a graded mesh ([`crate::analysis::graded::Grading::for_stresses`]) an element spanning several
     /// layers carries their mean membrane stress and is checked with the age of its upper
     /// (younger, weaker) row: the stress peak at a coarse row is smoothed, its strength taken low
     /// (`tests/green_state.rs` states how far from the full mesh this lands).
@@ -472,8 +472,8 @@ impl CapGreen {
         let grading = options
             .grading
             .as_ref()
-            .map(crate::analysis::window::Grading::for_stresses);
-        let analysed = crate::analysis::window::AnalysedState::new(state, grading.as_ref());
+            .map(crate::analysis::graded::Grading::for_stresses);
+        let analysed = crate::analysis::graded::AnalysedState::new(state, grading.as_ref());
         let Ok(shell) =
             crate::analysis::shell::state_shell(analysed.state(), material, options.row_stride)
         else {

@@ -30,10 +30,10 @@
 
 pub mod buckling;
 pub mod check;
+pub mod graded;
 pub mod green;
 pub mod shell;
 pub mod stress;
-pub mod window;
 
 pub use crate::form::overhang::layer_overhangs;
 pub use crate::input::ageing::Ageing;

@@ -168,7 +168,7 @@ pub struct AnalysisOptions {
     /// Kirchhoff element used before issue 17), `"andes_dkt"`, `"cst_dkmt"`.
     #[serde(default = "default_element")]
     pub element: ElementKind,
-    /// A graded shell mesh along the print direction (`crate::analysis::window`): every layer a row near
+    /// A graded shell mesh along the print direction (`crate::analysis::graded`): every layer a row near
     /// the top, rows thinning out with depth, so the cost per state stops growing with the bay
     /// length (issue 15). `None` (default): every layer is a row.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -242,7 +242,7 @@ impl AnalysisOptions {
 }
 
 /// A graded shell mesh along the print direction: every layer is a row near the top of the state,
-/// and the rows thin out with depth (see `crate::analysis::window::graded_rows`); deep rows also thin out across the
+/// and the rows thin out with depth (see `crate::analysis::graded::graded_rows`); deep rows also thin out across the
 /// span ([`Grading::transverse`]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -260,7 +260,7 @@ pub struct Grading {
     pub transverse: usize,
     /// Largest stride in the start section (layers with id < 0). Their feet stand on the base
     /// plane, pinned one per layer: a coarse row there leaves the support line pinned only
-    /// every few layers, which is where a coarse grading loses its accuracy (`crate::analysis::window`). The
+    /// every few layers, which is where a coarse grading loses its accuracy (`crate::analysis::graded`). The
     /// start section has a fixed number of layers, so this costs the same at every length.
     pub start_stride: usize,
     /// Zone rows when the shell's membrane stresses are checked too (a strength model in
@@ -275,7 +275,7 @@ pub struct Grading {
 impl Default for Grading {
     fn default() -> Self {
         // Checked against the full mesh in every state of the default and the 1.2 m cap
-        // (`crate::analysis::window`, `examples/graded_check.rs`).
+        // (`crate::analysis::graded`, `examples/graded_check.rs`).
         Grading {
             fine: 32,
             max_stride: 128,

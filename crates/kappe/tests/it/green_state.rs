@@ -444,7 +444,7 @@ type GreenRow = (Option<f64>, Option<f64>, Option<f64>);
 
 fn green_rows(
     design: &kappe::Design,
-    grading: Option<kappe::analysis::window::Grading>,
+    grading: Option<kappe::analysis::graded::Grading>,
 ) -> Vec<GreenRow> {
     let cap = kappe::design_cap(design, &|_| {}).expect("cap");
     let mut options = design.analysis.clone();
@@ -469,7 +469,7 @@ fn graded_mesh_with_the_strength_model_matches_the_full_mesh() {
          youngs_modulus_rate = 2000.0\ncohesion = 10000.0\nfriction_angle_deg = 20.0\n",
     )
     .expect("design");
-    let g = kappe::analysis::window::Grading::default();
+    let g = kappe::analysis::graded::Grading::default();
     let full = green_rows(&design, None);
     let graded = green_rows(&design, Some(g));
     assert_eq!(full.len(), graded.len());

@@ -1,4 +1,4 @@
-//! Analysis that scales (issue 15): the graded shell mesh (`kappe::analysis::window`) against the full
+//! Analysis that scales (issue 15): the graded shell mesh (`kappe::analysis::graded`) against the full
 //! mesh on the default cap and on the 1.2 m cap: every checked state's BLF within 1 % and the
 //! same governing state.
 //!
@@ -7,9 +7,9 @@
 //! scaling benchmark uses) at every 24th and the final one (7 of 136), so the test stays quick;
 //! the check of every state is the example
 //! `cargo run --release -p kappe --example graded_check -- 0.6` (and `-- 1.2`,
-//! `KAPPE_END=end_wall … -- 1.2`), whose numbers are in the `kappe::analysis::window` docs.
+//! `KAPPE_END=end_wall … -- 1.2`), whose numbers are in the `kappe::analysis::graded` docs.
 
-use kappe::analysis::window::{Grading, graded_rows};
+use kappe::analysis::graded::{Grading, graded_rows};
 use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
 use kappe::{Design, design_cap};
 
