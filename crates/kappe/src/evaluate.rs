@@ -223,11 +223,35 @@ fn evaluate_until(
         && let Some(r) = base_tolerance.as_ref().filter(|r| !r.ok())
     {
         extras.robot_error = Some(format!(
-            "the plan does not tolerate base-pose errors of ±{} m, ±{}°: {}",
-            tol.position,
+            "the plan does not survive a base placed up to ±{:.1} mm, ±{:.1}° off \
+             ([robot.tolerance]): {}. Place the base more precisely and lower the tolerance to \
+             match, or widen the base search ([robot.setup.base])",
+            tol.position * 1e3,
             tol.yaw_deg,
             r.problems.first().cloned().unwrap_or_default()
         ));
+    }
+    // The report's constraint table says whether the plan survives its stated base error.
+    if let Some(r) = &base_tolerance {
+        extras.constraints.push(kappe_report::ConstraintRow {
+            name: "base_tolerance".into(),
+            bound: kappe_report::Bound::AtMost,
+            limit: 0.0,
+            worst: r.problems.len() as f64,
+            unit: "problems".into(),
+            state: None,
+            element: Some(if r.ok() {
+                format!(
+                    "survives a base up to ±{:.1} mm, ±{:.1}° off (every station, {} points re-solved)",
+                    tol.position * 1e3,
+                    tol.yaw_deg,
+                    r.waypoints_checked
+                )
+            } else {
+                r.problems.first().cloned().unwrap_or_default()
+            }),
+            pass: r.ok(),
+        });
     }
     extras.schedule = report_schedule(&cap, analysis.as_ref(), schedule);
     let ok = crate::verdict::design_ok(&cap, &extras);

@@ -130,7 +130,20 @@ pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtra
                 worst: worst * scale,
                 unit: unit.to_string(),
                 state: c.state,
-                element: (!c.element.is_empty()).then(|| c.element.clone()),
+                // A failing row says what to change (issue 28), as the terminal does.
+                element: match (c.pass, c.element.is_empty()) {
+                    (true, true) => None,
+                    (true, false) => Some(c.element.clone()),
+                    (false, true) => Some(format!(
+                        "to fix: {}",
+                        crate::analysis::check::levers(c.name)
+                    )),
+                    (false, false) => Some(format!(
+                        "{}; to fix: {}",
+                        c.element,
+                        crate::analysis::check::levers(c.name)
+                    )),
+                },
                 pass: c.pass,
             })
         })
