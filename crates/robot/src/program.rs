@@ -511,13 +511,16 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
              stopped prints)\n",
         );
         text.push_str(&format!(
-            "# station {} (world_from_base rows {:?}), layers {}..{}, {} motion targets\n",
+            "# station {}: base at x {:.3} m, y {:.3} m, yaw {:.1}° (stations.md); layers {} to {}, {} motion targets\n",
             part.station + 1 + plan.mark.station_offset,
-            b,
+            b[0][3],
+            b[1][3],
+            b[1][0].atan2(b[0][0]).to_degrees(),
             part.first_layer,
             part.last_layer,
             targets
         ));
+        text.push_str(&format!("# world_from_base rows {b:?}\n"));
         text.push_str(&format!(
             "# plan time {:.3} s to {:.3} s; units m, rad, s; poses in the robot base frame\n",
             first_wp.t, last_wp.t
