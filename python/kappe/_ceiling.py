@@ -6,10 +6,10 @@ cluster when given a ``dask.distributed.Client``. The room summary equals ``ceil
 from __future__ import annotations
 
 import json
-import os
 from typing import Any, Dict, List, Optional, Tuple
 
 from . import _kappe
+from ._source import PathOrText, read_source
 
 __all__ = ["ceiling", "CeilingResult"]
 
@@ -50,7 +50,7 @@ class CeilingResult:
 
 
 def ceiling(
-    ceiling: str,
+    ceiling: PathOrText,
     client: Optional[Any] = None,
     no_robot: bool = False,
     allow_fail: bool = False,
@@ -59,13 +59,7 @@ def ceiling(
     run one after another (each bay's print states in parallel, the GIL released); with
     ``client`` (a ``dask.distributed.Client``) one task per bay runs on the cluster. Robot
     programs are included for passing bays, or for all with ``allow_fail``."""
-    if not isinstance(ceiling, str):
-        raise TypeError(f"ceiling: expected a path or TOML text, got {type(ceiling).__name__}")
-    if os.path.isfile(ceiling):
-        with open(ceiling, encoding="utf-8") as f:
-            text = f.read()
-    else:
-        text = ceiling
+    text, _, _ = read_source(ceiling, "ceiling")
     n = _kappe.ceiling_bays(text)
     if client is not None:
         futures = client.map(_run_bay, [text] * n, list(range(n)), [no_robot] * n, [allow_fail] * n, pure=False)

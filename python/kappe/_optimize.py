@@ -5,10 +5,10 @@ every constraint holds, with the least material."""
 from __future__ import annotations
 
 import json
-import os
 from typing import Any, Callable, Dict, Optional
 
 from . import _kappe
+from ._source import PathOrText, read_source
 
 __all__ = ["optimize", "OptimizeResult"]
 
@@ -43,7 +43,7 @@ class OptimizeResult:
 
 
 def optimize(
-    file: str,
+    file: PathOrText,
     max_evaluations: Optional[int] = None,
     progress: Optional[Callable[[Dict[str, Any]], Any]] = None,
 ) -> OptimizeResult:
@@ -52,16 +52,9 @@ def optimize(
     every evaluation with its dict (``evaluation``, ``parameters``, ``volume_m3``,
     ``violation``, ``failing``, ``accepted``); raising from it, or Ctrl-C, stops the loop after
     the evaluation under way (KeyboardInterrupt). The GIL is released while it runs."""
-    if not isinstance(file, str):
-        raise TypeError(f"file: expected a path or TOML text, got {type(file).__name__}")
     if max_evaluations is not None and (isinstance(max_evaluations, bool) or not isinstance(max_evaluations, int)):
         raise TypeError(f"max_evaluations: expected a whole number, got {max_evaluations!r}")
-    if os.path.isfile(file):
-        with open(file, encoding="utf-8") as f:
-            text = f.read()
-        directory = os.path.dirname(os.path.abspath(file))
-    else:
-        text, directory = file, os.getcwd()
+    text, _, directory = read_source(file, "optimize file")
     if progress is not None and not callable(progress):
         raise TypeError("progress: expected a callable progress(evaluation)")
     on_eval = None if progress is None else (lambda e: progress(json.loads(e)))

@@ -5,10 +5,10 @@ when given a ``dask.distributed.Client``. The rows equal those of ``kappe study`
 from __future__ import annotations
 
 import json
-import os
 from typing import Any, Dict, List, Optional
 
 from . import _kappe
+from ._source import PathOrText, read_source
 
 __all__ = ["study", "StudyResult"]
 
@@ -52,7 +52,7 @@ class StudyResult:
 
 
 def study(
-    study: str,
+    study: PathOrText,
     client: Optional[Any] = None,
     no_robot: bool = False,
     jobs: Optional[int] = None,
@@ -61,14 +61,7 @@ def study(
     run in parallel on ``jobs`` threads (default one per core; the GIL is released), exactly as
     ``kappe study`` runs them; with ``client`` (a ``dask.distributed.Client``) one task per
     design runs on the cluster."""
-    if not isinstance(study, str):
-        raise TypeError(f"study: expected a path or TOML text, got {type(study).__name__}")
-    if os.path.isfile(study):
-        with open(study, encoding="utf-8") as f:
-            text = f.read()
-        source, directory = os.path.basename(study), os.path.dirname(os.path.abspath(study))
-    else:
-        text, source, directory = study, "study.toml", os.getcwd()
+    text, source, directory = read_source(study, "study")
     if client is not None:
         parsed = json.loads(_kappe.study_parse(text, source, directory))
         indices = [d["index"] for d in parsed["designs"]]

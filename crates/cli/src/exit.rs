@@ -70,3 +70,21 @@ pub fn install_panic_hook() {
         std::process::exit(i32::from(INTERNAL));
     }));
 }
+
+/// Exit status after Ctrl-C (128 + SIGINT, as shells report it).
+pub const INTERRUPTED: u8 = 130;
+
+/// Ctrl-C says what happened before the process ends: outputs are swapped in only when
+/// complete, so an interrupted run has changed nothing unless it had finished writing (the
+/// hidden staging directory it leaves is removed by the next run).
+pub fn install_interrupt_handler() {
+    // Without a handler the default action still ends the process; only the message is lost.
+    let _ = ctrlc::set_handler(|| {
+        eprintln!(
+            "\ninterrupted (Ctrl-C): Kappe stopped. An output is put in place only when it is \
+             complete, so the output location holds the previous output (or nothing) unless \
+             this run had already finished writing"
+        );
+        std::process::exit(i32::from(INTERRUPTED));
+    });
+}

@@ -5,6 +5,7 @@
 
 mod cmd;
 mod exit;
+mod input;
 mod output;
 
 use std::process::ExitCode;
@@ -51,6 +52,7 @@ designs failed); 2 usage or input error (nothing is written); 3 internal error o
 
 fn main() -> ExitCode {
     exit::install_panic_hook();
+    exit::install_interrupt_handler();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Cem(c) => cmd::cem::run(c),

@@ -315,12 +315,15 @@ fn exit_status_scheme() {
     assert!(stderr(&o).contains("empty"), "{}", stderr(&o));
     assert!(!tmp.path().join("o2").exists());
     let o = run(&["design", "missing.toml", "--out", "o3"]);
+    // A missing input is a bad input the user fixes (README: 2), not an I/O failure of
+    // Kappe's (issue 28).
     assert_eq!(
         code(&o),
-        3,
-        "an unreadable file is an I/O failure: {}",
+        2,
+        "a missing input file is an input error: {}",
         stderr(&o)
     );
+    assert!(!tmp.path().join("o3").exists());
     // 1: the design fails its checks (a too-flat long span crushes, issue 6's failing case);
     // the summary and report are written so the user sees why, the robot program is not.
     std::fs::write(

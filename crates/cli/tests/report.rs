@@ -179,7 +179,13 @@ fn report_input_matches_closed_forms_and_the_summary() {
     let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(
         names,
-        ["sigma_min", "sigma_max", "overhang_max", "robot_plan"]
+        [
+            "sigma_min",
+            "sigma_max",
+            "overhang_max",
+            "robot_plan",
+            "base_tolerance"
+        ]
     );
     assert_eq!(input.constraints[0].limit, -20.0);
     assert_eq!(input.constraints[2].limit, 15.0);
@@ -187,7 +193,7 @@ fn report_input_matches_closed_forms_and_the_summary() {
     assert!(all_pass, "{:?}", input.constraints);
     let csv = std::fs::read_to_string(work.join("s/study.csv")).unwrap();
     assert!(csv.lines().nth(1).unwrap().contains(",pass,"), "{csv}");
-    assert!(html.contains("PASS: all 4 constraints met"));
+    assert!(html.contains("PASS: all 5 constraints met"));
     // The robot was planned (the design's default) and is animated from the plan's waypoints
     // (the page draws the UR10e meshes at the cell's stations): a station per frame, and the
     // timeline's point times are the waypoints' times.
@@ -247,7 +253,8 @@ fn failed_constraints_are_marked_in_the_report() {
             "sigma_max",
             "overhang_max",
             "blf_min",
-            "robot_plan"
+            "robot_plan",
+            "base_tolerance"
         ]
     );
     let row = |name: &str| input.constraints.iter().find(|c| c.name == name).unwrap();
@@ -263,5 +270,5 @@ fn failed_constraints_are_marked_in_the_report() {
     assert!(element.starts_with("layer -"), "{element}");
     assert!(input.states.iter().any(|s| !s.ok));
     let failing = input.constraints.iter().filter(|c| !c.pass).count();
-    assert!(html.contains(&format!("FAIL: {failing} of 5 constraints violated")));
+    assert!(html.contains(&format!("FAIL: {failing} of 6 constraints violated")));
 }

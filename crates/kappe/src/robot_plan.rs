@@ -43,6 +43,13 @@ pub fn robot_inputs(
         y1 = y1.max(p.bead.y);
     }
     let mut setup = r.setup.clone();
+    // Place the bases with the margin the tolerance check then verifies (issue 28).
+    if r.tolerance.check
+        && let kappe_robot::BasePlacement::Search(search) = &mut setup.base
+        && search.margin.is_none()
+    {
+        search.margin = Some(r.tolerance.base_tolerance());
+    }
     setup.obstacles.extend(beams(
         d.cap.span,
         r.beams.width,

@@ -93,8 +93,10 @@ impl std::fmt::Display for Failure {
                 problem,
             } => write!(
                 f,
-                "the plan does not tolerate base-pose errors of ±{position_m} m, ±{yaw_deg}°: \
-                 {problem}"
+                "the plan does not survive a base placed up to ±{:.1} mm, ±{yaw_deg:.1}° off \
+                 ([robot.tolerance]): {problem}. Place the base more precisely and lower the \
+                 tolerance to match, or widen the base search ([robot.setup.base])",
+                position_m * 1e3
             ),
         }
     }

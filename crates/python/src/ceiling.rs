@@ -20,10 +20,23 @@ fn parse(text: &str) -> PyResult<CeilingDesign> {
 
 fn output_error(e: &OutputError) -> PyErr {
     match e {
-        OutputError::Refused(m) => PyValueError::new_err(m.clone()),
+        OutputError::Refused(m) => PyValueError::new_err(python_terms(m)),
         OutputError::Io(m) => PyOSError::new_err(m.clone()),
         OutputError::Produce(m) => PyRuntimeError::new_err(m.clone()),
     }
+}
+
+/// The output library words its refusals for the command line (`--out DIR`, `--force`); a
+/// Python user passes a directory and `force=True` (issue 28).
+pub fn python_terms(message: &str) -> String {
+    message
+        .replace("pass --force", "pass force=True")
+        .replace("(--force)", "(force=True)")
+        .replace("without `--force`", "without force=True")
+        .replace("Choose another --out", "Choose another directory")
+        .replace("(give --out DIR)", "(give a directory)")
+        .replace("(e.g. --out out)", "(e.g. \"out\")")
+        .replace("--out ", "the directory ")
 }
 
 /// The number of bays of a ceiling file's text.
@@ -113,5 +126,6 @@ pub fn write_output(
         prepared.write(&files)?;
         prepared.commit()
     })
+    .map(|notice| notice.map(|n| python_terms(&n)))
     .map_err(|e| output_error(&e))
 }

@@ -78,6 +78,53 @@ fn coverage(ctx: &Context, w: &Iso, start: usize, stride: usize) -> usize {
     n
 }
 
+/// How many of the best candidates (by nominal cover) are re-scored under the margin: the
+/// re-score costs 8 coverages per candidate, and the planner tries only the first few anyway.
+const MARGIN_CANDIDATES: usize = 12;
+
+/// Re-score the best candidates of `order` by the layers they cover from every corner of the
+/// error box `tol` as well (the least of the nine covers), and put the best of those first.
+/// When no candidate keeps a layer under the margin, the nominal order stands (the plan's own
+/// tolerance check then reports the failure).
+fn robust_cover(
+    ctx: &Context,
+    cands: &[Iso],
+    mut cover: Vec<usize>,
+    order: &mut Vec<usize>,
+    tol: &crate::tolerance::BaseTolerance,
+    start: usize,
+) -> Vec<usize> {
+    let errors = crate::tolerance::sampled_errors(tol);
+    let top: Vec<usize> = order.iter().copied().take(MARGIN_CANDIDATES).collect();
+    let robust: Vec<usize> = top
+        .par_iter()
+        .map(|&ci| {
+            errors
+                .iter()
+                .skip(1)
+                .map(|&(dx, dy, da)| {
+                    let w = Iso::translation(dx, dy, 0.0)
+                        .mul(&cands[ci])
+                        .mul(&Iso::rot_z(da));
+                    // Every point: the corners sit at the edge of the reach, where a
+                    // configuration can be lost between two sampled points.
+                    coverage(ctx, &w, start, 1)
+                })
+                .fold(cover[ci], usize::min)
+        })
+        .collect();
+    if robust.iter().all(|&r| r == 0) {
+        return cover;
+    }
+    for (&ci, &r) in top.iter().zip(&robust) {
+        cover[ci] = r;
+    }
+    let mut kept: Vec<usize> = top.into_iter().filter(|&ci| cover[ci] > 0).collect();
+    kept.sort_by(|&a, &b| cover[b].cmp(&cover[a]).then(a.cmp(&b)));
+    *order = kept;
+    cover
+}
+
 /// Resolve the stations by search.
 pub(crate) fn search_stations(ctx: &Context, s: &BaseSearch) -> Result<Vec<Station>, RobotError> {
     let cands = candidates(ctx, s)?;
@@ -92,6 +139,10 @@ pub(crate) fn search_stations(ctx: &Context, s: &BaseSearch) -> Result<Vec<Stati
         let mut order: Vec<usize> = (0..cands.len()).filter(|&i| cover[i] > 0).collect();
         // Most layers first; the grid order (nearest the centre) breaks ties.
         order.sort_by(|&a, &b| cover[b].cmp(&cover[a]).then(a.cmp(&b)));
+        let cover = match &s.margin {
+            Some(tol) => robust_cover(ctx, &cands, cover, &mut order, tol, start),
+            None => cover,
+        };
         let mut done = false;
         let mut last_err: Option<Box<PlanFailure>> = None;
         for &ci in order.iter().take(4) {

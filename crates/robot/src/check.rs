@@ -106,18 +106,18 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         let world_from_base = match Iso::from_mat4(&st.world_from_base) {
             Ok(w) => w,
             Err(e) => {
-                problems.push(format!("station {si}: world_from_base {e}"));
+                problems.push(format!("station {}: world_from_base {e}", si + 1));
                 order += st.layers.len();
                 continue;
             }
         };
         if let Err(e) = ctx.check_base(&world_from_base) {
-            problems.push(format!("station {si}: {e}"));
+            problems.push(format!("station {}: {e}", si + 1));
         }
         let scene = match ctx.scene(&world_from_base) {
             Ok(s) => s,
             Err(e) => {
-                problems.push(format!("station {si}: {e}"));
+                problems.push(format!("station {}: {e}", si + 1));
                 order += st.layers.len();
                 continue;
             }
@@ -148,16 +148,17 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                     let c = scene.clearance(env.as_slice(), tag, CLEARANCE_CUTOFF);
                     if ds < opts.self_clearance || (c.distance <= 1e-12 && c.object.is_some()) {
                         problems.push(format!(
-                            "station {si}: the {what} pose collides ({:?})",
+                            "station {}: the {what} pose collides ({:?})",
+                            si + 1,
                             c.object.unwrap_or_default()
                         ));
                     } else if let Some(msg) =
                         transition_collision(&ctx, &scene, &world_from_base, &qa, &q, tag)
                     {
-                        problems.push(format!("station {si}: {what}: {msg}"));
+                        problems.push(format!("station {}: {what}: {msg}", si + 1));
                     }
                 }
-                Err(e) => problems.push(format!("station {si}: {what}: {e}")),
+                Err(e) => problems.push(format!("station {}: {what}: {e}", si + 1)),
             }
         }
         // Certified along the motion: each layer's moves from the previous layer's end (the
@@ -175,7 +176,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                     vec![qa, *q],
                     *tag,
                     [CONTACT, opts.self_clearance],
-                    format!("station {si}: the {what}"),
+                    format!("station {}: the {what}", si + 1),
                 ));
             }
         }
@@ -184,7 +185,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 path,
                 order + o,
                 [opts.clearance, opts.self_clearance],
-                format!("station {si}: the moves of layer {}", l.layer),
+                format!("station {}: the moves of layer {}", si + 1, l.layer),
             ));
         }
         let run = |k: usize| {
@@ -228,7 +229,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
             let mut branch = None;
             for w in &l.waypoints {
                 rep.waypoints += 1;
-                let at = || format!("station {si} layer {} point {}", l.layer, w.index);
+                let at = || format!("station {} layer {} point {}", si + 1, l.layer, w.index);
                 let q = w.q;
                 if !q.iter().all(|v| v.is_finite()) {
                     problems.push(format!("{}: non-finite joints", at()));
@@ -343,8 +344,10 @@ fn check_rates(
         let moved = (0..6).any(|j| q1[j] != q0[j]);
         if dt <= 0.0 && moved {
             problems.push(format!(
-                "station {si} layer {} point {}: moves in {dt} s",
-                at.0, at.1
+                "station {} layer {} point {}: moves in {dt} s",
+                si + 1,
+                at.0,
+                at.1
             ));
             continue;
         }
@@ -356,7 +359,8 @@ fn check_rates(
             // 1e-9: relative slack for the division.
             if r > 1.0 + 1e-9 {
                 problems.push(format!(
-                    "station {si} layer {} point {}: joint {} at {:.3} of its usable speed",
+                    "station {} layer {} point {}: joint {} at {:.3} of its usable speed",
+                    si + 1,
                     at.0,
                     at.1,
                     j + 1,
@@ -381,7 +385,8 @@ fn check_rates(
                     .get(k.min(rows.len().saturating_sub(1)))
                     .map_or((0, 0), |r| r.2);
                 problems.push(format!(
-                    "station {si} near layer {} point {}: joint {} accelerates at {:.3} of its limit",
+                    "station {} near layer {} point {}: joint {} accelerates at {:.3} of its limit",
+                    si + 1,
                     at.0,
                     at.1,
                     j + 1,

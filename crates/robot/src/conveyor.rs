@@ -529,6 +529,7 @@ pub fn tracking_program_files(
                 world_from_base: base_s0.to_mat4(),
                 start: first_wp.t,
                 end: last_wp.t,
+                mark: mp.plan.mark.clone(),
                 text,
             },
             TrackingStart {

@@ -27,6 +27,23 @@ pub enum FailureKind {
     BasePlacement,
 }
 
+impl FailureKind {
+    /// What failed, in the operator's words (messages never show the Rust name).
+    pub fn words(&self) -> &'static str {
+        match self {
+            FailureKind::Unreachable => "out of reach",
+            FailureKind::JointLimits => "outside the joint limits",
+            FailureKind::Singularity => "too close to a singularity",
+            FailureKind::SelfCollision => "the arm collides with itself",
+            FailureKind::Collision => "too close to an obstacle",
+            FailureKind::NoCompatibleNeighbour => "no configuration continues the previous one",
+            FailureKind::WindUp => "a joint winds up beyond its range",
+            FailureKind::Transition => "the move between two layers collides",
+            FailureKind::BasePlacement => "no usable base pose",
+        }
+    }
+}
+
 /// The first failing frame of a plan and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PlanFailure {
@@ -45,8 +62,12 @@ impl std::fmt::Display for PlanFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "station {}, layer {}, point {}: {:?}: {}",
-            self.station, self.layer, self.index, self.kind, self.detail
+            "station {}, layer {}, point {}: {}: {}",
+            self.station + 1,
+            self.layer,
+            self.index,
+            self.kind.words(),
+            self.detail
         )
     }
 }

@@ -424,7 +424,7 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
     let mut order = 0usize;
     for (si, st) in plan.stations.iter().enumerate() {
         let world_from_base = Iso::from_mat4(&st.world_from_base)
-            .map_err(|e| RobotError::invalid(format!("station {si} world_from_base"), e))?;
+            .map_err(|e| RobotError::invalid(format!("station {} world_from_base", si + 1), e))?;
         let scene = ctx.scene(&world_from_base)?;
         let probe = Probe {
             ctx: &ctx,
@@ -521,8 +521,11 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
             }
             if lb.iter().any(|v| *v <= 0.0) && along_problems.len() < 20 {
                 along_problems.push(format!(
-                    "station {si} layer {layer}: between the waypoints the collision meshes may touch (certified clearance to the environment {:.4} m, nozzle {:.4} m, self {:.4} m)",
-                    lb[0], lb[1], lb[2]
+                    "station {} layer {layer}: between the waypoints the collision meshes may touch (certified clearance to the environment {:.4} m, nozzle {:.4} m, self {:.4} m)",
+                    si + 1,
+                    lb[0],
+                    lb[1],
+                    lb[2]
                 ));
             }
         }
@@ -577,13 +580,19 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
         if o.mesh_env.0.min(o.nozzle.0) <= 0.0 && rep.problems.len() < 20 {
             rep.problems.push(format!(
                 "station {} layer {} point {}: the collision mesh touches the environment ({})",
-                o.at.0, o.at.1, o.at.2, o.mesh_env.1
+                o.at.0 + 1,
+                o.at.1,
+                o.at.2,
+                o.mesh_env.1
             ));
         }
         if o.mesh_self.0 <= 0.0 && rep.problems.len() < 20 {
             rep.problems.push(format!(
                 "station {} layer {} point {}: the collision meshes {} touch",
-                o.at.0, o.at.1, o.at.2, o.mesh_self.1
+                o.at.0 + 1,
+                o.at.1,
+                o.at.2,
+                o.mesh_self.1
             ));
         }
     }

@@ -129,9 +129,64 @@ pub struct Plan {
     /// ([`crate::check::CheckReport`]), when checked.
     #[serde(default)]
     pub certified: Option<CertifiedClearance>,
+    /// What the operator must know before running this plan's programs (a failing design, a
+    /// resumed print); every program's title, header, function name and `programs.json` say it.
+    #[serde(default, skip_serializing_if = "PlanMark::is_plain")]
+    pub mark: PlanMark,
     /// The setup (with the base placement resolved to the stations) and options used.
     pub setup: RobotSetup,
     pub options: PlanOptions,
+}
+
+/// Marks a plan whose programs are not the plain print of a passing design (issue 28): an
+/// operator who picks up a program file must see it in the file itself, not only in the run's
+/// terminal output.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlanMark {
+    /// The design fails its checks (programs written only with `--allow-fail`): what fails.
+    pub failing_design: Option<String>,
+    /// The plan continues an interrupted print from this layer (`kappe robot resume`).
+    pub resumed_from_layer: Option<i64>,
+    /// Stations of the original plan before this one's first (a resumed plan keeps the
+    /// original station numbers, which the operator's station sheet uses).
+    pub station_offset: usize,
+}
+
+impl PlanMark {
+    /// Neither mark.
+    pub fn is_plain(&self) -> bool {
+        self.failing_design.is_none()
+            && self.resumed_from_layer.is_none()
+            && self.station_offset == 0
+    }
+
+    /// The words for a program's title, e.g. `RESUME FROM LAYER -45, FAILING DESIGN`; empty
+    /// when plain.
+    pub fn title(&self) -> String {
+        let mut words = Vec::new();
+        if let Some(k) = self.resumed_from_layer {
+            words.push(format!("RESUME FROM LAYER {k}"));
+        }
+        if self.failing_design.is_some() {
+            words.push("FAILING DESIGN".to_string());
+        }
+        words.join(", ")
+    }
+
+    /// The suffix of a program's function name, e.g. `_resume_m45_failing`; empty when plain.
+    /// URScript names allow only letters, digits and `_`, so a negative layer is `m45`.
+    pub fn function_suffix(&self) -> String {
+        let mut s = String::new();
+        if let Some(k) = self.resumed_from_layer {
+            let sign = if k < 0 { "m" } else { "" };
+            s.push_str(&format!("_resume_{sign}{}", k.unsigned_abs()));
+        }
+        if self.failing_design.is_some() {
+            s.push_str("_failing");
+        }
+        s
+    }
 }
 
 /// Certified lower bounds of the capsule model's clearances along the whole motion (print moves,
@@ -1082,6 +1137,7 @@ pub(crate) fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
         parts: Vec::new(),
         meshes: None,
         certified: None,
+        mark: PlanMark::default(),
         setup,
         options: ctx.opts.clone(),
         stations,

@@ -234,6 +234,8 @@ pub struct ProgramFile {
     /// Plan times (s): arrival at the first and last target.
     pub start: f64,
     pub end: f64,
+    /// The plan's mark (failing design, resumed print), repeated in the file's title.
+    pub mark: crate::plan::PlanMark,
     #[serde(skip)]
     pub text: String,
 }
@@ -266,7 +268,7 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
             .get(part.first..=part.last)
             .ok_or_else(|| RobotError::invalid("parts", "names layers the station lacks"))?;
         let fname = format!("{prefix}{:02}.script", pi + 1);
-        let func = format!("kappe_part_{:02}", pi + 1);
+        let func = format!("kappe_part_{:02}{}", pi + 1, plan.mark.function_suffix());
         let mut w = String::new();
         let mut line = |s: &str| {
             w.push_str("  ");
@@ -482,19 +484,43 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
             )]));
         }
         let mut text = String::new();
+        let title = plan.mark.title();
         text.push_str(&format!(
-            "# Kappe print program {}/{} for a UR10e (generated; verified by kappe-robot check)\n",
+            "# Kappe print program {}/{} for a UR10e{} (generated; verified by kappe-robot check)\n",
             pi + 1,
-            n_parts
+            n_parts,
+            if title.is_empty() {
+                String::new()
+            } else {
+                format!(" -- {title}")
+            }
         ));
+        if let Some(why) = &plan.mark.failing_design {
+            text.push_str(&format!(
+                "# WARNING: the design FAILS its checks ({}); written only because of --allow-fail\n",
+                one_line(why)
+            ));
+        }
+        if let Some(k) = plan.mark.resumed_from_layer {
+            text.push_str(&format!(
+                "# RESUME: continues an interrupted print from layer {k}; the layers before it must stand\n"
+            ));
+        }
+        text.push_str(
+            "# operator's guide: docs/operator.md in the Kappe repository (origin, base placement, \
+             stopped prints)\n",
+        );
         text.push_str(&format!(
-            "# station {} (world_from_base rows {:?}), layers {}..{}, {} motion targets\n",
-            part.station + 1,
-            b,
+            "# station {}: base at x {:.3} m, y {:.3} m, yaw {:.1}° (stations.md); layers {} to {}, {} motion targets\n",
+            part.station + 1 + plan.mark.station_offset,
+            b[0][3],
+            b[1][3],
+            b[1][0].atan2(b[0][0]).to_degrees(),
             part.first_layer,
             part.last_layer,
             targets
         ));
+        text.push_str(&format!("# world_from_base rows {b:?}\n"));
         text.push_str(&format!(
             "# plan time {:.3} s to {:.3} s; units m, rad, s; poses in the robot base frame\n",
             first_wp.t, last_wp.t
@@ -509,10 +535,26 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
             world_from_base: *b,
             start: first_wp.t,
             end: last_wp.t,
+            mark: plan.mark.clone(),
             text,
         });
     }
     Ok(files)
+}
+
+/// A reason on one comment line (a newline would end the URScript comment).
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// The title of program `i` of `n`, as its first line says it.
+fn program_title(f: &ProgramFile, i: usize, n: usize) -> String {
+    let mark = f.mark.title();
+    if mark.is_empty() {
+        format!("Kappe print program {}/{n}", i + 1)
+    } else {
+        format!("Kappe print program {}/{n} -- {mark}", i + 1)
+    }
 }
 
 /// The index of the program files (JSON): in order, each with its station, base pose, layers,
@@ -526,7 +568,10 @@ pub fn index_json(files: &[ProgramFile]) -> String {
             serde_json::json!({
                 "order": i + 1,
                 "file": f.name,
-                "station": f.part.station + 1,
+                "station": f.part.station + 1 + f.mark.station_offset,
+                "title": program_title(f, i, files.len()),
+                "failing_design": f.mark.failing_design,
+                "resumed_from_layer": f.mark.resumed_from_layer,
                 "base_x_m": m[0][3],
                 "base_y_m": m[1][3],
                 "base_z_m": m[2][3],
@@ -567,7 +612,7 @@ pub fn resume_plan(plan: &Plan, layer: i64) -> Result<Plan, RobotError> {
         return Err(RobotError::invalid(
             "--from-layer",
             format!(
-                "layer {layer} is not in the plan (its layers are {}..={})",
+                "layer {layer} is not in the plan (its layers are {} to {})",
                 ids.first().copied().unwrap_or(0),
                 ids.last().copied().unwrap_or(0)
             ),
@@ -576,6 +621,8 @@ pub fn resume_plan(plan: &Plan, layer: i64) -> Result<Plan, RobotError> {
     let mut out = plan.clone();
     // The mesh clearances were measured on the whole print.
     out.meshes = None;
+    out.mark.resumed_from_layer = Some(layer);
+    out.mark.station_offset += si;
     out.stations.drain(..si);
     if let Some(st) = out.stations.first_mut() {
         st.layers.drain(..li);

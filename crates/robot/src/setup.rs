@@ -95,6 +95,13 @@ pub struct BaseSearch {
     pub z: f64,
     /// Every n-th point of each layer is used to score a candidate.
     pub score_stride: usize,
+    /// Base-pose errors the chosen poses must tolerate (issue 28): a layer counts as covered
+    /// by a candidate only when it is also reachable with the base at every corner of this
+    /// error box ([`crate::tolerance`]), so a station does not end at the edge of the reach,
+    /// where a base a few millimetres off can no longer print its last layers. `None`: the
+    /// nominal pose only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub margin: Option<crate::tolerance::BaseTolerance>,
 }
 
 impl Default for BaseSearch {
@@ -111,6 +118,7 @@ impl Default for BaseSearch {
             yaw_deg: vec![270.0],
             z: 0.0,
             score_stride: 5,
+            margin: None,
         }
     }
 }

@@ -154,3 +154,135 @@ pub fn station_schedule(plan: &Plan, drive: &DriveSpec) -> Result<StationSchedul
         total_time: station_time + relocation_time,
     })
 }
+
+/// The station sheet (`stations.md`, issue 28): what the operator needs at each station, in
+/// print order: where the base stands (x, y, yaw in the world frame of docs/operator.md), how
+/// precisely it must stand (the base tolerance the plan was checked against, and whether this
+/// station survives it), the layers it prints, its program files and its time. `programs` is
+/// the file prefix of the written programs, or `None` with the reason none were written.
+pub fn station_sheet(
+    plan: &Plan,
+    tolerance: Option<&crate::tolerance::ToleranceReport>,
+    programs: Result<&str, &str>,
+) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    let _ = writeln!(t, "# Station sheet\n");
+    let _ = writeln!(
+        t,
+        "Where the mobile base stands for each part of the print, in print order. World frame \
+         (docs/operator.md in the Kappe repository): origin on the top face of the beams, midway \
+         between their inner faces, where the first centre layer (layer 0) meets the beams; x \
+         across the span, y along the beams toward the printing front (the start layers, with \
+         negative numbers, lie at y < 0), z up. Base x, y: the robot base frame's origin; yaw: \
+         the angle of its x axis from world x, counter-clockwise seen from above.\n"
+    );
+    let offset = plan.mark.station_offset;
+    if let Some(why) = &plan.mark.failing_design {
+        let _ = writeln!(
+            t,
+            "**WARNING: the design fails its checks ({why}).** Print only for a test.\n"
+        );
+    }
+    if let Some(k) = plan.mark.resumed_from_layer {
+        let _ = writeln!(
+            t,
+            "**Resumed print** from layer {k}: the layers before it must already stand.\n"
+        );
+    }
+    match tolerance {
+        Some(r) => {
+            let tol = &r.tolerance;
+            let _ = writeln!(
+                t,
+                "Base placement tolerance checked: ±{:.1} mm in x and y, ±{:.1}° in yaw \
+                 ({} poses per station, every {} point(s) re-solved). {}\n",
+                tol.position * 1e3,
+                tol.yaw_deg,
+                r.poses_per_station,
+                tol.stride,
+                if r.ok() {
+                    "Every station survives it: place each base at least this precisely."
+                } else {
+                    "**The plan does NOT survive it** (see the stations marked FAILS)."
+                }
+            );
+        }
+        None => {
+            let _ = writeln!(
+                t,
+                "The base placement tolerance was not checked ([robot.tolerance] check = false): \
+                 place the base as precisely as you can.\n"
+            );
+        }
+    }
+    let sched = match station_schedule(plan, &DriveSpec::default()) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = writeln!(t, "The stations cannot be listed: {e}");
+            return t;
+        }
+    };
+    let _ = writeln!(
+        t,
+        "| station | base x [m] | base y [m] | base yaw [°] | tolerance | layers | programs | print time [min] | then drive |"
+    );
+    let _ = writeln!(t, "|---|---|---|---|---|---|---|---|---|");
+    for s in &sched.stations {
+        let n = s.index + 1 + offset;
+        let tol = match tolerance {
+            None => "not checked".to_string(),
+            Some(r) => {
+                let prefix = format!("station {n},");
+                let bad = r.problems.iter().filter(|p| p.starts_with(&prefix)).count();
+                let (p, y) = (r.tolerance.position * 1e3, r.tolerance.yaw_deg);
+                if bad == 0 {
+                    format!("±{p:.1} mm, ±{y:.1}°: survives")
+                } else {
+                    format!("±{p:.1} mm, ±{y:.1}°: FAILS ({bad} problem(s))")
+                }
+            }
+        };
+        let files = match programs {
+            Ok(prefix) => {
+                let list: Vec<String> = plan
+                    .parts
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, p)| p.station == s.index)
+                    .map(|(i, _)| format!("{prefix}{:02}.script", i + 1))
+                    .collect();
+                list.join(", ")
+            }
+            Err(_) => "none written".to_string(),
+        };
+        let drive = if s.relocation_distance > 0.0 {
+            format!(
+                "{:.2} m ({:.0} s with settling)",
+                s.relocation_distance, s.relocation_time
+            )
+        } else {
+            "done".to_string()
+        };
+        let _ = writeln!(
+            t,
+            "| {n} | {:.3} | {:.3} | {:.1} | {tol} | {} to {} | {files} | {:.1} | {drive} |",
+            s.base[0],
+            s.base[1],
+            s.base[2],
+            s.layers[0],
+            s.layers[1],
+            (s.print_window[1] - s.print_window[0]) / 60.0
+        );
+    }
+    if let Err(why) = programs {
+        let _ = writeln!(t, "\nNo programs were written: {why}.");
+    }
+    let _ = writeln!(
+        t,
+        "\nTotal: {:.1} min at the stations, {:.1} min driving and settling between them.",
+        sched.station_time / 60.0,
+        sched.relocation_time / 60.0
+    );
+    t
+}

@@ -147,7 +147,7 @@ pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport
             let st = &plan.stations[si];
             let Ok(nominal) = Iso::from_mat4(&st.world_from_base) else {
                 r.problems
-                    .push(format!("station {si}: world_from_base is not a rigid transform"));
+                    .push(format!("station {}: world_from_base is not a rigid transform", si + 1));
                 return r;
             };
             // The error is a drive error: a shift on the floor and a turn about the base's own
@@ -156,7 +156,8 @@ pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport
                 .mul(&nominal)
                 .mul(&Iso::rot_z(da));
             let at = format!(
-                "station {si}, base off by ({:+.1} mm, {:+.1} mm, {:+.2}°)",
+                "station {}, base off by ({:+.1} mm, {:+.1} mm, {:+.2}°)",
+                si + 1,
                 dx * 1e3,
                 dy * 1e3,
                 da.to_degrees()

@@ -32,8 +32,7 @@ pub struct BuildabilityArgs {
 }
 
 pub fn run(args: BuildabilityArgs) -> Result<ExitCode> {
-    let text = std::fs::read_to_string(&args.spec)
-        .with_context(|| format!("cannot read the buildability spec {}", args.spec.display()))?;
+    let text = crate::input::read_text(&args.spec, "buildability spec")?;
     let resolved = kappe::commands::buildability::BuildabilitySpec::from_toml_str(&text)
         .with_context(|| format!("invalid buildability spec {}", args.spec.display()))?;
     // The output location is checked before any computing (nothing is written on bad input).

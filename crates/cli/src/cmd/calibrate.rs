@@ -62,8 +62,7 @@ pub fn run(args: CalibrateArgs) -> Result<ExitCode> {
     if let Some(out) = &args.out {
         check_user_file(out, args.force)?;
     }
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read the prototype file {}", path.display()))?;
+    let text = crate::input::read_text(path, "prototype file")?;
     if kappe::commands::calibrate_blf::is_prints_file(&text) {
         return run_prints(&args, &text);
     }

@@ -71,6 +71,8 @@ fn load(input: Option<&Path>, example: bool) -> Result<TopologyFile> {
     let Some(path) = input else {
         return Err(Usage("give an INPUT.json or --example".into()).into());
     };
+    // An unreadable or non-UTF-8 file is a bad input (exit 2), not an I/O failure of Kappe's.
+    crate::input::read_text(path, "topology file")?;
     Ok(report::read_topology_file(path)?)
 }
 

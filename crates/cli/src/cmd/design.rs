@@ -47,8 +47,7 @@ pub fn run(args: DesignArgs) -> Result<ExitCode> {
     let design = match &args.design {
         None => kappe::Design::default(),
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read the design file {}", path.display()))?;
+            let text = crate::input::read_text(path, "design file")?;
             if kappe::commands::ceiling::is_ceiling_toml(&text) {
                 return run_ceiling(&args, &text, path);
             }

@@ -107,6 +107,8 @@ fn load(
     allow_mixed_orientation: bool,
     element: Option<ElementArg>,
 ) -> Result<ShellModel> {
+    // An unreadable or non-UTF-8 file is a bad input (exit 2), not an I/O failure of Kappe's.
+    crate::input::read_text(path, "mesh file")?;
     Ok(summary::read_mesh_file(
         path,
         allow_mixed_orientation,

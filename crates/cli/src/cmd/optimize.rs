@@ -51,8 +51,7 @@ pub struct OptimizeArgs {
 
 pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
     let path = &args.file;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::input::read_text(path, "optimize file")?;
     let (mut file, embedded) = OptimizeFile::from_any_toml_str(&text)
         .with_context(|| format!("invalid optimize file {}", path.display()))?;
     if let Some(n) = args.max_evaluations {

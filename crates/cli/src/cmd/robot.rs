@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Subcommand;
 use kappe_robot::{Plan, check_plan, files, lint_with_limits};
 
@@ -57,6 +57,10 @@ pub enum RobotCommand {
         /// Output directory (default DIR/resume_from_layer_K; replaced atomically).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Write the programs even when the design fails its checks (they are marked as the
+        /// programs of a failing design).
+        #[arg(long)]
+        allow_fail: bool,
     },
 }
 
@@ -72,8 +76,16 @@ pub fn write_plan_outputs(
     Ok(())
 }
 
+/// Whether DIR/summary.json (when there is one) says the design fails its checks.
+fn summary_says_fails(dir: &Path) -> bool {
+    std::fs::read(dir.join("summary.json"))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .is_some_and(|v| v.get("ok") == Some(&serde_json::Value::Bool(false)))
+}
+
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    Ok(crate::input::read_text(path, "input file")?)
 }
 
 pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
@@ -164,9 +176,32 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
             dir,
             from_layer,
             out,
+            allow_fail,
         } => {
             let plan_path = dir.join("plan.json");
-            let plan = files::parse_plan(&read(&plan_path)?, &plan_path.display().to_string())?;
+            let mut plan = files::parse_plan(&read(&plan_path)?, &plan_path.display().to_string())?;
+            // A plan.json written before plans carried their mark: the summary beside it
+            // still knows whether the design passed.
+            if plan.mark.failing_design.is_none() && summary_says_fails(&dir) {
+                plan.mark.failing_design = Some(format!(
+                    "{} says the design fails its checks",
+                    dir.join("summary.json").display()
+                ));
+            }
+            if let Some(why) = &plan.mark.failing_design {
+                if !allow_fail {
+                    eprintln!(
+                        "error: the design of {} fails its checks ({why}); no resume programs written. \
+                         Fix the design, or rerun with --allow-fail to write them anyway (marked as \
+                         the programs of a failing design)",
+                        plan_path.display()
+                    );
+                    return Ok(crate::exit::fails());
+                }
+                eprintln!(
+                    "warning: the design fails its checks ({why}); the programs are marked FAILING DESIGN"
+                );
+            }
             let (resumed, programs) =
                 match files::resume_with_programs(&plan, from_layer, "resume_part") {
                     Err(e @ kappe_robot::RobotError::Verification(_)) => Err(anyhow::Error::new(e)

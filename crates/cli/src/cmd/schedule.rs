@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::Args;
 
+use crate::exit::Usage;
 use crate::output::{prepare_dir, write_file_atomic};
 
 #[derive(Args)]
@@ -30,10 +31,21 @@ pub struct ScheduleArgs {
 }
 
 pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
-    let text = std::fs::read_to_string(&args.design)
-        .with_context(|| format!("cannot read the design file {}", args.design.display()))?;
+    let text = crate::input::read_text(&args.design, "design file")?;
     let design = kappe::Design::from_toml_str(&text)
         .with_context(|| format!("invalid design file {}", args.design.display()))?;
+    // Without a time model every layer is equally stiff at any age, so waiting never helps:
+    // the search would print one zero wait per layer and look like an answer.
+    if design.material.time.is_none() {
+        return Err(Usage(format!(
+            "{} has no [material.time] table: kappe schedule finds the waits that let the \
+             layers gain stiffness and strength with age, and without a time model waiting never \
+             helps. Add [material.time] (docs/green-state.md; `kappe init --kind buildability` \
+             shows one), or use `kappe design` to check the design as it is",
+            args.design.display()
+        ))
+        .into());
+    }
     let prepared = match &args.out {
         Some(out) => Some(prepare_dir(out, args.force, "kappe schedule")?),
         None => None,
@@ -57,14 +69,111 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
     if args.json {
         print!("{json}");
     } else {
-        print!(
-            "{}",
-            kappe::commands::least_waits::text_report(&plan, args.wait_max)
-        );
+        print!("{}", text_report(&design, &plan, args.wait_max));
     }
     Ok(if plan.infeasible.is_empty() {
         ExitCode::SUCCESS
     } else {
         crate::exit::fails()
     })
+}
+
+/// What `kappe schedule` prints: the print times, one line per state that needed a wait (its
+/// wait and the check that bound it), and either the `[schedule] waits` to add to the design or,
+/// when some state fails even at `--wait-max`, a clear infeasible verdict (no waits to add:
+/// they would not make the design pass) with what to change instead.
+fn text_report(
+    design: &kappe::Design,
+    plan: &kappe::commands::least_waits::WaitPlan,
+    wait_max: f64,
+) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{} print states; print time {:.1} min without waits, {:.1} min with the least waits \
+         ({:.1} min of waits)",
+        plan.states.len(),
+        plan.total_without_waits_s / 60.0,
+        plan.total_s / 60.0,
+        plan.schedule.total_wait_s() / 60.0
+    );
+    if !plan.binding.is_empty() {
+        let _ = writeln!(t, "waits needed ({}):", plan.binding.len());
+    }
+    for b in &plan.binding {
+        let _ = writeln!(
+            t,
+            "  state {:>4}: wait {:.1} s before its top layer ({} binds)",
+            b.state,
+            b.wait_s,
+            b.check.map_or("-", |m| m.name())
+        );
+    }
+    if plan.infeasible.is_empty() {
+        let list: Vec<String> = plan
+            .schedule
+            .layers
+            .iter()
+            .map(|l| format!("{:.1}", l.wait_s))
+            .collect();
+        let _ = writeln!(t, "FEASIBLE: every state passes with these waits.");
+        let _ = writeln!(t, "add to the design to print and check this schedule:");
+        let _ = writeln!(t, "[schedule]\nwaits = [{}]", list.join(", "));
+        return t;
+    }
+    let blf_min = design.constraints.blf_min;
+    let mut by_check: std::collections::BTreeMap<&str, usize> = Default::default();
+    for c in &plan.infeasible {
+        *by_check
+            .entry(c.governing.map_or("-", |m| m.name()))
+            .or_default() += 1;
+    }
+    let counts: Vec<String> = by_check
+        .iter()
+        .map(|(k, n)| format!("{k} in {n}"))
+        .collect();
+    let _ = writeln!(
+        t,
+        "INFEASIBLE: {} of {} states fail even with {:.0} s of wait before their top layer \
+         (governing: {}); no schedule of waits makes this design pass.",
+        plan.infeasible.len(),
+        plan.states.len(),
+        wait_max,
+        counts.join(", ")
+    );
+    let show = |c: &kappe::commands::least_waits::StateCheck| {
+        let mut parts = Vec::new();
+        if let Some(b) = c.blf {
+            parts.push(format!("BLF {b:.2} (needs {blf_min:.2})"));
+        }
+        if let Some(u) = c.strength {
+            parts.push(format!("strength used {:.0} %", 100.0 * u));
+        }
+        if let Some(u) = c.sliding {
+            parts.push(format!("sliding used {:.0} %", 100.0 * u));
+        }
+        parts.join(", ")
+    };
+    if let Some(c) = plan.infeasible.first() {
+        let _ = writeln!(t, "  first failing state {:>4}: {}", c.state, show(c));
+    }
+    if let Some(c) = plan.infeasible.iter().max_by(|a, b| {
+        let worst = |c: &kappe::commands::least_waits::StateCheck| {
+            c.blf
+                .map_or(0.0, |b| if b > 0.0 { blf_min / b } else { f64::INFINITY })
+                .max(c.strength.unwrap_or(0.0))
+                .max(c.sliding.unwrap_or(0.0))
+        };
+        worst(a).total_cmp(&worst(b))
+    }) {
+        let _ = writeln!(t, "  worst state          {:>4}: {}", c.state, show(c));
+    }
+    let _ = writeln!(
+        t,
+        "to fix: change the design, not the waits: for buckling raise cap.rise or widen \
+         print.layer_width; for strength or sliding a stiffer, faster-setting mix \
+         ([material.time]); a larger --wait-max only if the print may pause that long"
+    );
+    t
 }

@@ -100,6 +100,7 @@ fn store(prepared: &PreparedDir, v: &Variation, step: Step<'_>) -> Result<(), St
 
 fn print_summary(result: &StudyResult, out: &Path) {
     print!("{}", result.overview());
+    print!("{}", result_table(result));
     println!(
         "  wrote {}/{{study.csv, study.html, study.json, designs/}}",
         out.display()
@@ -116,8 +117,7 @@ fn run_study(args: RunArgs) -> Result<ExitCode> {
         })?),
         other => other.map(kappe::commands::study::parse_shard).transpose()?,
     };
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read the study file {}", path.display()))?;
+    let text = crate::input::read_text(&path, "study file")?;
     let source = path.file_name().map_or_else(
         || path.display().to_string(),
         |s| s.to_string_lossy().into_owned(),
@@ -249,4 +249,53 @@ fn merge(args: MergeArgs) -> Result<ExitCode> {
         return Ok(crate::exit::fails());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The small result table (issue 28): per design its verdict, the governing check (the one
+/// nearest its limit, or the first that fails), the lowest BLF, mass and print time, so the
+/// terminal answers "which design, and why" without opening study.html.
+fn result_table(result: &StudyResult) -> String {
+    use std::fmt::Write as _;
+    let mut t = format!(
+        "  {:<24} {:<13} {:<16} {:>9} {:>10} {:>10}\n",
+        "design", "verdict", "governing check", "min BLF", "mass [kg]", "time [min]"
+    );
+    let opt = |v: Option<f64>, scale: f64, digits: usize| {
+        v.map_or("-".to_string(), |x| format!("{:.*}", digits, x * scale))
+    };
+    for r in &result.rows {
+        let _ = writeln!(
+            t,
+            "  {:<24} {:<13} {:<16} {:>9} {:>10} {:>10}",
+            r.name,
+            match r.outcome {
+                kappe::commands::study::Verdict::Pass => "passes",
+                kappe::commands::study::Verdict::Fail => "FAILS",
+                kappe::commands::study::Verdict::Error => "could not run",
+            },
+            governing(&r.constraints),
+            opt(r.min_blf, 1.0, 2),
+            opt(r.mass_kg, 1.0, 1),
+            opt(r.print_time_s, 1.0 / 60.0, 1),
+        );
+    }
+    t
+}
+
+/// The first failing check, else the one nearest its limit (utilisation worst/limit, or
+/// limit/worst for a lower bound on a positive factor such as the BLF); "-" without checks.
+fn governing(rows: &[kappe_report::ConstraintRow]) -> String {
+    if let Some(c) = rows.iter().find(|c| !c.pass) {
+        return c.name.clone();
+    }
+    let use_of = |c: &kappe_report::ConstraintRow| match c.bound {
+        kappe_report::Bound::AtLeast if c.limit > 0.0 && c.worst > 0.0 => c.limit / c.worst,
+        _ if c.limit != 0.0 => c.worst / c.limit,
+        _ => 0.0,
+    };
+    rows.iter()
+        .map(|c| (use_of(c), c))
+        .filter(|(u, _)| u.is_finite())
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or("-".to_string(), |(_, c)| c.name.clone())
 }

@@ -126,21 +126,27 @@ impl Analysis {
         self.constraints.iter().filter(|c| !c.pass)
     }
 
-    /// The report as plain text, one line per constraint.
+    /// The report as plain text, one line per constraint, numbers in the user's units (kPa,
+    /// mm, plain factors: [`readable`]) and, for a failing constraint, what to change
+    /// ([`levers`]).
     pub fn report(&self) -> String {
         let mut s = String::new();
         for c in &self.constraints {
-            let worst = c.worst.map_or("n/a".to_string(), |w| format!("{w:.6e}"));
+            let worst = c
+                .worst
+                .map_or("not checked".to_string(), |w| readable(w, c.unit));
             let at = c
                 .state
                 .map_or(String::new(), |st| format!(" at state {st}, {}", c.element));
             s.push_str(&format!(
-                "{:<13} {:<4} limit {:.6e} {}, worst {worst}{at}\n",
+                "{:<13} {:<4} limit {}, worst {worst}{at}\n",
                 c.name,
                 if c.pass { "PASS" } else { "FAIL" },
-                c.limit,
-                c.unit,
+                readable(c.limit, c.unit),
             ));
+            if !c.pass {
+                s.push_str(&format!("{:<18} to fix: {}\n", "", levers(c.name)));
+            }
         }
         s.push_str(if self.ok {
             "design passes every constraint\n"
@@ -148,6 +154,44 @@ impl Analysis {
             "design FAILS\n"
         });
         s
+    }
+}
+
+/// A value of a constraint in the user's units: stresses in kPa, lengths in mm, factors plain
+/// (no unit). Stresses below 0.005 kPa print as 0.00 kPa: the force pass leaves roundoff of
+/// ~1e-9 Pa in an all-compression arch, which must not read as a tension.
+pub fn readable(value: f64, unit: &str) -> String {
+    match unit {
+        "Pa" => {
+            let kpa = value / 1e3;
+            format!("{:.2} kPa", if kpa.abs() < 0.005 { 0.0 } else { kpa })
+        }
+        "m" => format!("{:.1} mm", value * 1e3),
+        "1" => format!("{value:.3}"),
+        other => format!("{value} {other}"),
+    }
+}
+
+/// What would make a failing constraint pass, in the design file's terms (issue 28).
+pub fn levers(name: &str) -> &'static str {
+    match name {
+        "sigma_min" => {
+            "the compression is too high: raise cap.rise or shorten cap.span (less thrust per \
+             layer), or use a stronger mix (constraints.sigma_min, [material.time]); \
+             `kappe optimize` searches the free parameters for you"
+        }
+        "sigma_max" => {
+            "the arch is in tension: raise cap.rise or shorten cap.span so the layer arch stays \
+             in compression, or use a mix with tensile strength (constraints.sigma_max); \
+             `kappe optimize` searches the free parameters for you"
+        }
+        "blf_min" => {
+            "the shell buckles: raise cap.rise, widen the layers (print.layer_width: a thicker \
+             shell), or wait between layers so they stiffen (`kappe schedule` finds the least \
+             waits)"
+        }
+        "overhang_max" => "the layers overhang too far: lower cap.tilt_deg or print.layer_height",
+        _ => "see the report (report.html) for the governing state",
     }
 }
 

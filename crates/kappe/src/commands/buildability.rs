@@ -614,13 +614,16 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
     let o = &r.spec.object;
     let _ = writeln!(
         t,
-        "{} {:?}: {} layers of {:.1} mm, {:.2} s per layer, {} elements along the centre line",
+        "{} ({}): {} layers of {:.1} mm, {:.2} s per layer, {} elements along the centre line",
         if r.spec.name.is_empty() {
             "buildability"
         } else {
             &r.spec.name
         },
-        o.kind,
+        match o.kind {
+            ObjectKind::Wall => "wall",
+            ObjectKind::Cylinder => "cylinder",
+        },
         b.states.len(),
         o.layer_height * 1e3,
         b.layer_time_s,

@@ -584,17 +584,47 @@ impl CeilingOutcome {
             self.bays.len(),
             out.display()
         );
+        // The small result table (issue 28): per bay its verdict, the governing check, the
+        // lowest BLF, mass and print time, so the terminal answers "which bay, and why".
+        t.push_str(&format!(
+            "  {:<4} {:>8} {:<22} {:<7} {:<16} {:>9} {:>10} {:>10}\n",
+            "bay",
+            "span [m]",
+            "printed as",
+            "verdict",
+            "governing check",
+            "min BLF",
+            "mass [kg]",
+            "time [min]"
+        ));
         for (i, bay) in self.bays.iter().enumerate() {
+            let row = bay.summary();
+            let governing = row["worst_constraint"]["name"].as_str().unwrap_or("-");
             t.push_str(&format!(
-                "  bay {}: span {:.3} m, {} half/halves, {}\n",
+                "  {:<4} {:>8.3} {:<22} {:<7} {:<16} {:>9} {:>10.1} {:>10.1}\n",
                 i + 1,
                 bay.design.cap.span,
-                bay.halves,
-                if bay.outcome.verdict.ok {
+                if bay.halves == 2 {
+                    "two mirrored halves"
+                } else {
+                    "one piece"
+                },
+                if row["ok"] == json!(true) {
                     "passes"
                 } else {
                     "FAILS"
-                }
+                },
+                governing,
+                bay.outcome
+                    .min_blf()
+                    .map_or("-".to_string(), |b| format!("{b:.2}")),
+                row["mass_kg"].as_f64().unwrap_or(0.0),
+                row["robot"]["time_s"]
+                    .as_f64()
+                    .filter(|t| *t > 0.0)
+                    .or(row["print_time_s"].as_f64())
+                    .unwrap_or(0.0)
+                    / 60.0
             ));
         }
         t
@@ -637,11 +667,24 @@ impl BayOutcome {
             OutputFile::new("path.csv", eval.cap.path.to_csv()),
         ];
         if eval.verdict.ok || allow_fail {
+            // Each half with its station sheet (issue 28).
+            let sheet =
+                |plan: &kappe_robot::Plan,
+                 tol: Option<&kappe_robot::tolerance::ToleranceReport>| {
+                    OutputFile::new(
+                        "stations.md",
+                        kappe_robot::stations::station_sheet(plan, tol, Ok("program_part")),
+                    )
+                };
             if let Some(Ok(plan)) = &eval.robot {
-                out.extend(plan_files(plan, "program_part", true)?);
+                let plan = eval.marked_plan(plan);
+                out.extend(plan_files(&plan, "program_part", true)?);
+                out.push(sheet(&plan, eval.base_tolerance.as_ref()));
             }
             if let Some(Ok(plan)) = &self.mirror_plan {
-                let files = plan_files(plan, "program_part", true)?;
+                let plan = eval.marked_plan(plan);
+                let mut files = plan_files(&plan, "program_part", true)?;
+                files.push(sheet(&plan, self.mirror_tolerance.as_ref()));
                 out.extend(files.into_iter().map(|f| f.under("mirror")));
             }
         }

@@ -132,9 +132,9 @@ pub struct ToleranceSpec {
     pub yaw_deg: f64,
     /// Check every n-th waypoint of a layer (and always its first and last).
     pub stride: usize,
-    /// A plan that does not tolerate the errors fails the design. Off by default until the
-    /// planner keeps the margins the check needs (the default design's plan fails it at
-    /// ±10 mm, ±1°: a self-distance of 3.5 mm at station 0, layer 66).
+    /// A plan that does not tolerate the errors fails the design (on by default, issue 28:
+    /// the base search keeps the same margin, so the default design's plan survives ±10 mm,
+    /// ±1°; a plan that does not is never written as "verified" without a word).
     pub verdict: bool,
 }
 
@@ -146,7 +146,7 @@ impl Default for ToleranceSpec {
             position: t.position,
             yaw_deg: t.yaw_deg,
             stride: t.stride,
-            verdict: false,
+            verdict: true,
         }
     }
 }
@@ -428,10 +428,16 @@ impl Design {
         check(
             "print.path_sampling",
             p.path_sampling,
-            p.path_sampling > 0.0 && p.path_sampling <= c.span / 8.0,
+            // The cost guard (issue 28): a bead smooths out path detail finer than half its
+            // width, so finer sampling only multiplies nodes, states' meshes and robot targets
+            // (1e-7 m ran for minutes into gigabytes before).
+            p.path_sampling >= 0.5 * p.layer_width - 1e-12 && p.path_sampling <= c.span / 8.0,
             format!(
-                "allowed: 0 < Δs ≤ span/8 = {:.4} m (at least 8 segments per arch)",
-                c.span / 8.0
+                "allowed: {:.1} mm (half the layer width: the bead smooths out finer detail, \
+                 finer sampling only multiplies the run time) to {:.1} mm (span/8: at least 8 \
+                 segments per arch)",
+                0.5 * p.layer_width * 1e3,
+                c.span / 8.0 * 1e3
             ),
         )?;
         check(
@@ -504,6 +510,17 @@ impl Design {
             bm.overrun >= 0.0,
             "allowed: overrun ≥ 0 m",
         )?;
+        // Checked here, before any computing, not first by the planner after the analysis.
+        let moves = self.robot.plan.program.max_moves_per_program;
+        if moves < 4 {
+            return Err(DesignError::Invalid {
+                field: "robot.plan.program.max_moves_per_program",
+                value: moves.to_string(),
+                allowed: "allowed: at least 4 (a program needs an approach, a descent, a print \
+                          move and a retract)"
+                    .into(),
+            });
+        }
         Ok(())
     }
 }
@@ -528,13 +545,31 @@ pub(crate) fn parse_toml<T: serde::de::DeserializeOwned>(text: &str) -> Result<T
     })?;
     serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
-        let message = e.into_inner().message().trim().to_string();
+        let message = plain_types(e.into_inner().message().trim());
         let message = match did_you_mean(&message) {
             Some(hint) => format!("{message} (did you mean `{hint}`?)"),
             None => message,
         };
         DesignError::Parse { path, message }
     })
+}
+
+/// serde names Rust types ("invalid type: integer `1`, expected struct CapSpec"); the user wrote
+/// a TOML file, in which such a thing is a table.
+fn plain_types(message: &str) -> String {
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(i) = rest.find("struct ") {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + "struct ".len()..];
+        let end = after
+            .find(|c: char| !c.is_alphanumeric() && c != '_')
+            .unwrap_or(after.len());
+        out.push_str("a table");
+        rest = &after[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// For serde's "unknown field `x`, expected one of `a`, `b`, …", the expected name closest to `x`

@@ -316,10 +316,26 @@ impl PreparedDir {
         let mut notice = None;
         match &self.previous {
             Previous::Nothing | Previous::EmptyDir => {
-                std::fs::rename(&self.staging, &self.target)
-                    .map_err(|e| io("cannot move the output into place at", e))?;
+                std::fs::rename(&self.staging, &self.target).map_err(|e| {
+                    // Checked empty or absent before the run: someone else wrote it meanwhile.
+                    if self.target.symlink_metadata().is_ok() && !list_entries_empty(&self.target) {
+                        OutputError::Refused(format!(
+                            "{} was filled by another run (or another program) while this one \
+                             ran; this run's output was not put in place and the other was left \
+                             as it is. Run one Kappe command per output directory at a time, and \
+                             run this one again",
+                            self.target.display()
+                        ))
+                    } else {
+                        io("cannot move the output into place at", e)
+                    }
+                })?;
             }
             Previous::Kappe => {
+                // Outputs of other commands nested inside (`kappe robot resume` writes
+                // DIR/resume_from_layer_K/) belong to the previous output's plan: moved aside
+                // with a notice, never deleted with it (issue 28).
+                notice = move_nested_aside(&self.target)?;
                 match exchange(&self.staging, &self.target) {
                     Ok(()) => {}
                     Err(_) => {
@@ -465,6 +481,48 @@ fn list_files(dir: &Path) -> std::io::Result<Vec<String>> {
     }
     out.sort();
     Ok(out)
+}
+
+/// Move the Kappe outputs nested in the output `target` (a subdirectory with its own
+/// manifest) to `TARGET.old-N/<same path>`; a notice naming them, or `None` when there are none.
+fn move_nested_aside(target: &Path) -> Result<Option<String>> {
+    let files = list_files(target)
+        .map_err(|e| OutputError::Io(format!("cannot read {}: {e}", target.display())))?;
+    let suffix = format!("/{MANIFEST}");
+    let mut roots: Vec<String> = Vec::new();
+    for f in &files {
+        if let Some(dir) = f.strip_suffix(&suffix)
+            && !roots.iter().any(|r| dir.starts_with(&format!("{r}/")))
+        {
+            roots.push(dir.to_string());
+        }
+    }
+    if roots.is_empty() {
+        return Ok(None);
+    }
+    let aside = free_aside_name(target);
+    let mut moved = Vec::new();
+    for r in &roots {
+        let to = aside.join(r);
+        if let Some(parent) = to.parent() {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| OutputError::Io(format!("cannot create {}: {e}", parent.display())))?;
+        }
+        std::fs::rename(target.join(r), &to).map_err(|e| {
+            OutputError::Io(format!(
+                "cannot move {} aside to {}: {e}",
+                target.join(r).display(),
+                to.display()
+            ))
+        })?;
+        moved.push(format!("{r}/"));
+    }
+    Ok(Some(format!(
+        "kept {} (written by another Kappe command from the previous output, e.g. \
+         `kappe robot resume`) by moving it aside to {}",
+        moved.join(", "),
+        aside.display()
+    )))
 }
 
 fn free_aside_name(target: &Path) -> PathBuf {

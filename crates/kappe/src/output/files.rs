@@ -93,9 +93,50 @@ impl Outcome {
         // The layer times the structural check and the robot share (issue 11).
         out.push(OutputFile::new("schedule.csv", self.schedule.to_csv()));
         if let Some(Ok(plan)) = &self.robot {
-            out.extend(plan_files(plan, "program_part", self.programs().is_ok())?);
+            let plan = self.marked_plan(plan);
+            let programs = self.programs();
+            out.extend(plan_files(&plan, "program_part", programs.is_ok())?);
+            // The operator's station sheet (issue 28): base pose, tolerance, layers, programs
+            // and time per station.
+            let sheet = kappe_robot::stations::station_sheet(
+                &plan,
+                self.base_tolerance.as_ref(),
+                programs
+                    .as_ref()
+                    .map(|_| "program_part")
+                    .map_err(String::as_str),
+            );
+            out.push(OutputFile::new("stations.md", sheet));
         }
         Ok(out)
+    }
+
+    /// `plan` as its files carry it: marked as the plan of a failing design when the design
+    /// fails, so that its programs (with `--allow-fail`) and `plan.json` (which
+    /// `kappe robot resume` reads) say so (issue 28).
+    pub fn marked_plan(&self, plan: &Plan) -> Plan {
+        let mut plan = plan.clone();
+        if !self.verdict.ok {
+            let mut why: Vec<String> = self
+                .analysis
+                .iter()
+                .flat_map(|a| a.failing())
+                .map(|c| format!("{} fails", c.name))
+                .collect();
+            if let Some(t) = self.base_tolerance.as_ref().filter(|t| !t.ok()) {
+                why.push(format!(
+                    "the plan does not survive a base ±{:.1} mm, ±{:.1}° off",
+                    t.tolerance.position * 1e3,
+                    t.tolerance.yaw_deg
+                ));
+            }
+            plan.mark.failing_design = Some(if why.is_empty() {
+                "the design fails its checks".into()
+            } else {
+                why.join("; ")
+            });
+        }
+        plan
     }
 
     /// The table `kappe design` prints: the design, the layer arch, the states, the worst
@@ -150,7 +191,13 @@ impl Outcome {
             "max compression stress [kPa]",
             format!("{:.2}", worst_c / 1e3),
         );
-        row(&mut t, "max tension stress [Pa]", format!("{worst_t:.3e}"));
+        // kPa like the compression: the all-compression arch's roundoff tension (~1e-9 Pa)
+        // reads 0.00, not as a tension in scientific notation (issue 28).
+        row(
+            &mut t,
+            "max tension stress [kPa]",
+            crate::analysis::check::readable(worst_t, "Pa").replace(" kPa", ""),
+        );
         row(&mut t, "max node residual [N]", format!("{worst_res:.3e}"));
         row(
             &mut t,
@@ -213,6 +260,32 @@ impl Outcome {
             Some(Err(e)) => writeln!(t, "  robot: NOT PLANNED: {e}"),
             None => writeln!(t, "  robot: planning skipped"),
         };
+        // Whether the plan survives the stated base error, never only in summary.json.
+        if let Some(r) = &self.base_tolerance {
+            let tol = &r.tolerance;
+            let _ = if r.ok() {
+                writeln!(
+                    t,
+                    "  base tolerance: the plan survives a base up to ±{:.1} mm, ±{:.1}° off at every station",
+                    tol.position * 1e3,
+                    tol.yaw_deg
+                )
+            } else {
+                writeln!(
+                    t,
+                    "  base tolerance: FAILS at ±{:.1} mm, ±{:.1}° ({} problem(s){}): {}",
+                    tol.position * 1e3,
+                    tol.yaw_deg,
+                    r.problems.len(),
+                    if d.robot.tolerance.verdict {
+                        ""
+                    } else {
+                        "; not in the verdict: [robot.tolerance] verdict = false"
+                    },
+                    r.problems.first().map_or("", String::as_str)
+                )
+            };
+        }
         t
     }
 
@@ -222,19 +295,27 @@ impl Outcome {
         let mut lines = Vec::new();
         if let Some(Err(e)) = &self.robot {
             lines.push(format!("{level}: the robot cannot print this design: {e}"));
+        } else {
+            // A plan that exists but fails the design, e.g. one that does not survive the
+            // stated base error ([robot.tolerance]).
+            for f in &self.verdict.failures {
+                if let crate::verdict::Failure::BaseTolerance { .. } = f {
+                    lines.push(format!("{level}: {f}"));
+                }
+            }
         }
         if !self.verdict.ok {
+            use crate::analysis::check::{levers, readable};
             for c in self.analysis.iter().flat_map(|a| a.failing()) {
                 lines.push(format!(
-                    "{level}: constraint {} fails: worst {} {} against the limit {} {}{}",
+                    "{level}: constraint {} fails: worst {} against the limit {}{}",
                     c.name,
-                    c.worst.map_or("n/a".into(), |w| format!("{w:.4e}")),
-                    c.unit,
-                    c.limit,
-                    c.unit,
+                    c.worst.map_or("n/a".into(), |w| readable(w, c.unit)),
+                    readable(c.limit, c.unit),
                     c.state
                         .map_or(String::new(), |s| format!(" (state {s}, {})", c.element))
                 ));
+                lines.push(format!("  to fix: {}", levers(c.name)));
             }
         }
         lines

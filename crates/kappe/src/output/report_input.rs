@@ -141,7 +141,20 @@ fn row_of(c: &crate::analysis::ConstraintResult) -> Option<ConstraintRow> {
         worst: worst * scale,
         unit: unit.to_string(),
         state: c.state,
-        element: (!c.element.is_empty()).then(|| c.element.clone()),
+        // A failing row says what to change (issue 28), as the terminal does.
+        element: match (c.pass, c.element.is_empty()) {
+            (true, true) => None,
+            (true, false) => Some(c.element.clone()),
+            (false, true) => Some(format!(
+                "to fix: {}",
+                crate::analysis::check::levers(c.name)
+            )),
+            (false, false) => Some(format!(
+                "{}; to fix: {}",
+                c.element,
+                crate::analysis::check::levers(c.name)
+            )),
+        },
         pass: c.pass,
     })
 }
@@ -833,19 +846,29 @@ impl crate::Outcome {
         if let Some(plan) = &self.robot {
             add_robot(&mut extras, plan);
         }
-        for f in &self.verdict.failures {
-            if let crate::verdict::Failure::BaseTolerance { problem, .. } = f {
-                extras.constraints.push(ConstraintRow {
-                    name: "base_tolerance".into(),
-                    bound: Bound::AtMost,
-                    limit: 0.0,
-                    worst: 1.0,
-                    unit: "failures".into(),
-                    state: None,
-                    element: Some(format!("{f}; first: {problem}")),
-                    pass: false,
-                });
-            }
+        // The constraint table says whether the plan survives its stated base error (issue 28).
+        if let Some(r) = &self.base_tolerance {
+            let tol = &self.cap.design.robot.tolerance;
+            extras.constraints.push(ConstraintRow {
+                name: "base_tolerance".into(),
+                bound: Bound::AtMost,
+                limit: 0.0,
+                worst: r.problems.len() as f64,
+                unit: "problems".into(),
+                state: None,
+                element: Some(if r.ok() {
+                    format!(
+                        "survives a base up to ±{:.1} mm, ±{:.1}° off (every station, {} points \
+                         re-solved)",
+                        tol.position * 1e3,
+                        tol.yaw_deg,
+                        r.waypoints_checked
+                    )
+                } else {
+                    r.problems.first().cloned().unwrap_or_default()
+                }),
+                pass: r.ok(),
+            });
         }
         extras.schedule = Some(crate::output::schedule_report::report_schedule(
             &self.cap,

@@ -107,6 +107,8 @@ fn base_tolerance_in_the_design_pipeline() {
         ..kappe::Options::of(&d)
     };
     let go = |_: kappe::Progress| std::ops::ControlFlow::Continue(());
+    // In the verdict by default (issue 28); off here to see the report alone first.
+    d.robot.tolerance.verdict = false;
     d.robot.tolerance.position = 0.0;
     d.robot.tolerance.yaw_deg = 0.0;
     let zero = kappe::run(&d, &options, &go).unwrap();
@@ -139,7 +141,9 @@ fn base_tolerance_in_the_design_pipeline() {
         enforced.verdict.failures.iter().any(|f| matches!(
             f,
             kappe::verdict::Failure::BaseTolerance { .. }
-        ) && f.to_string().contains("base-pose errors")),
+        ) && f
+            .to_string()
+            .contains("does not survive a base placed up to")),
         "{:?}",
         enforced.verdict.failures
     );

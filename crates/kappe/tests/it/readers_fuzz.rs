@@ -137,7 +137,7 @@ proptest! {
                 let msg = err.to_string();
                 prop_assert!(!msg.is_empty());
                 prop_assert!(
-                    msg.contains("design file") || fields.iter().any(|f| msg.contains(f.as_str()))
+                    msg.contains("TOML parse error") || fields.iter().any(|f| msg.contains(f.as_str()))
                         || msg.contains('.'),
                     "{msg}"
                 );
