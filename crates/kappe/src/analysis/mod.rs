@@ -31,6 +31,7 @@
 pub mod buckling;
 pub mod check;
 pub mod green;
+pub mod reliability;
 pub mod shell;
 pub mod stress;
 pub mod window;
