@@ -43,7 +43,9 @@ pub fn class_of(cause: &(dyn std::error::Error + 'static)) -> Option<Class> {
     }
     if let Some(e) = cause.downcast_ref::<DesignError>() {
         return Some(match e {
-            DesignError::Parse { .. } | DesignError::Invalid { .. } => Class::Input,
+            DesignError::Parse { .. }
+            | DesignError::Invalid { .. }
+            | DesignError::Uncertainty { .. } => Class::Input,
             // The design as given has no equilibrium form within its bounds: it fails.
             DesignError::FormFinding(_) => Class::Fails,
             DesignError::Cem(inner) => cem(inner),

@@ -135,6 +135,8 @@ pub struct Outcome {
     /// Stresses, overhang and buckling of every state, and the constraint report; `None` when
     /// not asked for.
     pub analysis: Option<Analysis>,
+    /// β and P_f of every state and of the print under `[uncertainty]` (None without it).
+    pub reliability: Option<crate::analysis::reliability::Reliability>,
     /// Pass or fail, and why ([`crate::verdict::verdict`]).
     pub verdict: Verdict,
     /// [`Options::allow_fail`] of the run.
@@ -204,6 +206,12 @@ fn evaluate_until(
         None => None,
     };
     check(stop)?;
+    // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.
+    let reliability = match &analysis {
+        Some(a) => crate::analysis::reliability::reliability(&cap, a, &schedule)?,
+        None => None,
+    };
+    check(stop)?;
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
     let tol = &cap.design.robot.tolerance;
@@ -214,7 +222,7 @@ fn evaluate_until(
         )),
         _ => None,
     };
-    let verdict = crate::verdict::verdict(
+    let mut verdict = crate::verdict::verdict(
         &cap,
         analysis.as_ref(),
         RobotResults {
@@ -222,9 +230,32 @@ fn evaluate_until(
             tolerance: base_tolerance.as_ref(),
         },
     );
+    if let Some(r) = &reliability
+        && r.beta < r.beta_min
+    {
+        // After the structural constraints, before the robot's failures.
+        let at = verdict
+            .failures
+            .iter()
+            .take_while(|f| matches!(f, crate::verdict::Failure::Constraint { .. }))
+            .count();
+        verdict.failures.insert(
+            at,
+            crate::verdict::Failure::Constraint {
+                name: "beta_min".into(),
+                worst: Some(r.beta),
+                limit: r.beta_min,
+                unit: "1".into(),
+                state: Some(r.governing_state),
+                element: r.governing_check.clone(),
+            },
+        );
+        verdict.ok = false;
+    }
     Ok(Outcome {
         cap,
         robot,
+        reliability,
         base_tolerance,
         schedule,
         analysis,

@@ -32,6 +32,7 @@ pub mod buckling;
 pub mod check;
 pub mod graded;
 pub mod green;
+pub mod reliability;
 pub mod shell;
 pub mod stress;
 

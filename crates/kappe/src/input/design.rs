@@ -28,6 +28,9 @@ pub struct Design {
     pub schedule: crate::input::schedule::ScheduleSpec,
     /// Analysis settings: which states get a buckling analysis, modes, layer ageing.
     pub analysis: crate::input::analysis::AnalysisOptions,
+    /// Uncertain parameters, correlation and drift (issue 24); absent: deterministic only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<crate::input::uncertainty::UncertaintyTable>,
 }
 
 /// Global geometry (method.md §2).
@@ -94,6 +97,10 @@ pub struct ConstraintSpec {
     pub blf_min: f64,
     /// l_o,max: largest allowed layer overhang, m. Default lw/2 (method.md §3).
     pub overhang_max: Option<f64>,
+    /// β_min: least reliability index of the print (issue 24), checked only when the design has
+    /// an `[uncertainty]` table. Default [`crate::input::uncertainty::BETA_MIN_DEFAULT`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_min: Option<f64>,
 }
 
 /// Robot and tool settings for the motion planner (method.md §8, robot.md).
@@ -212,6 +219,7 @@ impl Default for Design {
             robot: RobotSpec::default(),
             schedule: crate::input::schedule::ScheduleSpec::default(),
             analysis: crate::input::analysis::AnalysisOptions::default(),
+            uncertainty: None,
         }
     }
 }
@@ -259,6 +267,7 @@ impl Default for ConstraintSpec {
             sigma_max: 0.0,
             blf_min: 1.0,
             overhang_max: None,
+            beta_min: None,
         }
     }
 }
@@ -487,8 +496,19 @@ impl Design {
                 "allowed: l_o,max > 0 m",
             )?;
         }
+        if let Some(b) = k.beta_min {
+            check(
+                "constraints.beta_min",
+                b,
+                b > 0.0 && b < 8.0,
+                "allowed: 0 < β_min < 8 (P_f from 0.5 to 6e-16)",
+            )?;
+        }
         self.analysis.validate()?;
         self.time_model()?;
+        if let Some(u) = &self.uncertainty {
+            u.model(self)?;
+        }
         self.schedule.waits(self.schedule.waits.len().max(1))?;
         self.schedule.relocation_time()?;
         let bm = &self.robot.beams;

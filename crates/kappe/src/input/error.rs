@@ -38,6 +38,15 @@ pub enum DesignError {
     /// from code).
     #[error("cannot write the design as TOML: {0}")]
     ToToml(String),
+    /// An `[uncertainty]` entry that is not allowed (issue 24): unknown name, bad distribution,
+    /// correlation or drift.
+    #[error("design field `{field}`: {message}")]
+    Uncertainty {
+        /// Dotted field, e.g. `uncertainty."material.youngs_modulus".std`.
+        field: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
     /// The caller's progress callback asked the run to stop (e.g. Ctrl-C in Python).
     #[error("cancelled")]
     Cancelled,

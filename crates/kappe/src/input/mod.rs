@@ -10,6 +10,7 @@ pub mod error;
 pub mod material;
 pub mod resolve;
 pub mod schedule;
+pub mod uncertainty;
 
 pub use design::Design;
 pub use error::DesignError;

@@ -232,6 +232,14 @@ impl Outcome {
             "print time [min]",
             format!("{:.1}", self.print_time() / 60.0),
         );
+        if let Some(r) = &self.reliability {
+            // One line (issue 24): the print's β against its target, and P_f.
+            row(
+                &mut t,
+                &format!("reliability β (min {:.2}) / P_f", r.beta_min),
+                format!("{:.2} / {:.2e}", r.beta, r.pf),
+            );
+        }
         let _ = writeln!(
             t,
             "  wrote {}/{{summary.json, network.json, path.csv, cap.obj, cap.glb, report.html}}",

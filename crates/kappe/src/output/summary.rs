@@ -75,6 +75,9 @@ pub struct Summary {
     pub ok: bool,
     /// The failing checks (empty when `ok`).
     pub failures: Vec<Failure>,
+    /// The print's reliability under `[uncertainty]` (issue 24; absent without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reliability: Option<crate::analysis::reliability::Reliability>,
 }
 
 /// Sizes of the model.
@@ -188,6 +191,15 @@ pub struct StateEntry {
     /// Where the shell model is a mechanism.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mechanism: Option<String>,
+    /// Reliability index of the state's checks as a series system (only with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// Probability of failure of the state (only with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pf: Option<f64>,
+    /// β per check, e.g. `{"buckling": …, "sigma_min": …}` (only with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_by_check: Option<std::collections::BTreeMap<String, f64>>,
 }
 
 /// One constraint of the analysis.
@@ -332,6 +344,10 @@ impl Outcome {
             .enumerate()
             .map(|(i, s)| {
                 let a = analysis.and_then(|a| a.states.get(i));
+                let r = self
+                    .reliability
+                    .as_ref()
+                    .and_then(|r| r.states.iter().find(|r| r.index == s.index));
                 StateEntry {
                     index: s.index,
                     progress: s.progress,
@@ -357,6 +373,9 @@ impl Outcome {
                     bottom_age_s: a.and_then(|a| a.bottom_age_s),
                     ok: a.map(|a| a.ok),
                     mechanism: a.and_then(|a| a.mechanism.clone()),
+                    beta: r.map(|r| r.beta),
+                    pf: r.map(|r| r.pf),
+                    beta_by_check: r.map(|r| r.beta_by_check.clone()),
                 }
             })
             .collect();
@@ -430,6 +449,7 @@ impl Outcome {
             },
             ok: self.verdict.ok,
             failures: self.verdict.failures.clone(),
+            reliability: self.reliability.clone(),
         }
     }
 

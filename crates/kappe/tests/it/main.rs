@@ -9,6 +9,7 @@ mod ends;
 mod floors;
 mod green_state;
 mod readers_fuzz;
+mod reliability;
 mod scale;
 mod shell_element;
 mod summary_schema;

@@ -1,0 +1,390 @@
+//! Reliability of every analysed print state and of the print (issue 24): β and P_f of each
+//! check under the design's `[uncertainty]`, by FORM ([`kappe_reliability::form`]), and the
+//! print's P_f as a series system over states × checks ([`kappe_reliability::series_system`]).
+//!
+//! Limit states of state q (failure g ≤ 0), with γ the specific weight, E the uniform Young's
+//! modulus, ν Poisson's ratio and a 0-subscript the design's (analysed) value:
+//!
+//! * buckling: g = BLF₀·(E/E₀)·(γ₀/γ)·(1 + s_ν(ν − ν₀)) − BLF_min;
+//! * compression: g = σ_min,q,₀·γ/γ₀ − σ_min; tension: g = σ_max − σ_max,q,₀·γ/γ₀;
+//! * strength (with a strength model): g = 1 − u₀·γ/γ₀.
+//!
+//! The γ and E factors are exact, not linearisations: the CEM force pass and the shell's static
+//! solve are linear in the self-weight load, so every stress (and the Mohr–Coulomb demand, which is
+//! homogeneous of degree 1 in the stresses) scales with γ; the element stresses of the statically
+//! determinate force pass do not depend on E; and with one uniform modulus the shell's stiffness
+//! K is linear in E while its geometric stiffness K_G is linear in the load, so the eigenvalue of
+//! (K + λK_G)φ = 0 scales as E/γ. The ν term is not exact: s_ν = (∂BLF/∂ν)/BLF₀ is a central
+//! difference of two re-solves at ν₀ ± [`NU_STEP`] per state (first order in ν; ν's coefficient of
+//! variation is small, and the re-solve test bounds the error).
+//!
+//! A check that no random variable enters (e.g. stresses when only E is uncertain) is
+//! deterministic: the deterministic verdict already holds it, and it is left out here.
+//!
+//! Drift: the state printed at t (h, the end of its top layer on the run's schedule) uses the
+//! variables scaled by each drift's factor c(t) ([`kappe_reliability::Model::drifted`]); all states
+//! share one u-space, which the series system needs.
+
+use std::collections::BTreeMap;
+
+use kappe_reliability::{
+    Component, FormOptions, FormResult, Model, SystemOptions, WithGradient, form, series_system,
+};
+use serde::{Deserialize, Serialize};
+
+use super::buckling::{state_buckling, state_material_with};
+use super::check::Analysis;
+use crate::form::cap::Cap;
+use crate::form::states::build_state;
+use crate::input::error::DesignError;
+use crate::input::uncertainty::BETA_MIN_DEFAULT;
+
+/// Absolute step in ν of the central difference ∂BLF/∂ν: small against ν's range (0, 0.5) and its
+/// scatter, large against the eigensolver's relative residual (1e-8) times BLF/h.
+pub const NU_STEP: f64 = 1e-3;
+
+/// Samples of each state's own series system (its few checks).
+const STATE_SYSTEM_SAMPLES: u64 = 4_000;
+
+/// The reliability of one state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct StateReliability {
+    /// State index.
+    pub index: usize,
+    /// Print time of the state, h (drift is evaluated here).
+    pub t_hours: f64,
+    /// β of the state's checks as a series system.
+    pub beta: f64,
+    /// P_f of the state.
+    pub pf: f64,
+    /// β per check (`buckling`, `sigma_min`, `sigma_max`, `strength`).
+    pub beta_by_check: BTreeMap<String, f64>,
+}
+
+/// One parameter's share in the governing check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct Sensitivity {
+    /// Importance factor γᵢ² (sums to 1 over the parameters).
+    pub importance: f64,
+    /// ∂β/∂μᵢ, per unit of the parameter.
+    pub dbeta_dmean: f64,
+    /// ∂β/∂σᵢ, per unit of the parameter.
+    pub dbeta_dstd: f64,
+}
+
+/// The reliability of the print.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct Reliability {
+    /// β of the print (series system over states × checks).
+    pub beta: f64,
+    /// P_f of the print.
+    pub pf: f64,
+    /// 95 % interval of the sampled P_f.
+    pub pf_interval: [f64; 2],
+    /// The target β_min.
+    pub beta_min: f64,
+    /// State and check of the governing component (largest P_f).
+    pub governing_state: usize,
+    /// Check name of the governing component.
+    pub governing_check: String,
+    /// Most probable failing values of each parameter (governing component).
+    pub design_point: BTreeMap<String, f64>,
+    /// Sensitivities of the governing component's β.
+    pub sensitivities: BTreeMap<String, Sensitivity>,
+    /// Every state checked (in `summary.json` per state, not here).
+    #[serde(skip)]
+    pub states: Vec<StateReliability>,
+    /// Components in the series system.
+    pub components: usize,
+    /// Wall-clock seconds of the reliability analysis (re-solves included).
+    pub seconds: f64,
+}
+
+/// What a check of one state depends on; see the module docs.
+#[derive(Debug, Clone, Copy)]
+pub enum Check {
+    /// BLF₀ and s_ν.
+    Buckling {
+        /// BLF at the design's values.
+        blf: f64,
+        /// (∂BLF/∂ν)/BLF₀.
+        s_nu: f64,
+    },
+    /// σ_min,q,₀ (≤ 0).
+    Compression(f64),
+    /// σ_max,q,₀ (≥ 0).
+    Tension(f64),
+    /// u₀.
+    Strength(f64),
+}
+
+impl Check {
+    fn name(self) -> &'static str {
+        match self {
+            Check::Buckling { .. } => "buckling",
+            Check::Compression(_) => "sigma_min",
+            Check::Tension(_) => "sigma_max",
+            Check::Strength(_) => "strength",
+        }
+    }
+}
+
+/// Indices of γ, E, ν in the model, and their analysed values.
+#[derive(Debug, Clone, Copy)]
+pub struct Vars {
+    gamma: Option<usize>,
+    e: Option<usize>,
+    nu: Option<usize>,
+    gamma0: f64,
+    e0: f64,
+    nu0: f64,
+}
+
+impl Vars {
+    /// Where γ, E and ν sit in `model`, and their nominal values from the cap's design.
+    pub fn of(model: &Model, cap: &Cap) -> Self {
+        let find = |n: &str| model.variables().iter().position(|v| v.name == n);
+        let m = &cap.design.material;
+        Vars {
+            gamma: find("material.specific_weight"),
+            e: find("material.youngs_modulus"),
+            nu: find("material.poisson_ratio"),
+            gamma0: m.specific_weight,
+            e0: m.youngs_modulus,
+            nu0: m.poisson_ratio,
+        }
+    }
+}
+
+/// g(x) of `check` and its gradient (exact: every factor is a product of powers).
+pub fn limit_state(
+    check: Check,
+    v: Vars,
+    limits: (f64, f64, f64),
+    x: &[f64],
+    grad: &mut [f64],
+) -> f64 {
+    let (sigma_min, sigma_max, blf_min) = limits;
+    grad.iter_mut().for_each(|g| *g = 0.0);
+    let at = |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+    let gamma = at(v.gamma, v.gamma0);
+    let rg = gamma / v.gamma0;
+    let mut set = |i: Option<usize>, d: f64| {
+        if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+            *g = d;
+        }
+    };
+    match check {
+        Check::Buckling { blf, s_nu } => {
+            let e = at(v.e, v.e0);
+            let nu = at(v.nu, v.nu0);
+            let lin = 1.0 + s_nu * (nu - v.nu0);
+            let val = blf * (e / v.e0) / rg * lin;
+            set(v.e, val / e);
+            set(v.gamma, -val / gamma);
+            set(v.nu, blf * (e / v.e0) / rg * s_nu);
+            val - blf_min
+        }
+        Check::Compression(s) => {
+            set(v.gamma, s / v.gamma0);
+            s * rg - sigma_min
+        }
+        Check::Tension(s) => {
+            set(v.gamma, -s / v.gamma0);
+            sigma_max - s * rg
+        }
+        Check::Strength(u) => {
+            set(v.gamma, -u / v.gamma0);
+            1.0 - u * rg
+        }
+    }
+}
+
+/// The checks of every state that a random variable enters, with the state's print time (h).
+fn state_checks(
+    cap: &Cap,
+    analysis: &Analysis,
+    schedule: &crate::schedule::Schedule,
+    v: Vars,
+) -> Result<Vec<(usize, f64, Vec<Check>)>, DesignError> {
+    let options = &analysis.options;
+    let phi = cap.design.print.start_arch_fraction;
+    let green = crate::analysis::green::CapGreen::with_schedule(cap, Some(schedule))?;
+    let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
+    let k = &cap.design.constraints;
+    let scale = analysis.states.iter().fold(0.0_f64, |m, s| {
+        m.max(s.max_compression_stress_pa.abs())
+            .max(s.max_tension_stress_pa.abs())
+    });
+    let stol = super::stress::STRESS_REL_TOL * scale;
+    let mut out = Vec::with_capacity(analysis.states.len());
+    for s in &analysis.states {
+        let t_hours = schedule.layers.get(s.index).map_or(0.0, |l| l.end_s) / 3600.0;
+        let mut checks = Vec::new();
+        if let Some(blf) = s.blf
+            && (v.gamma.is_some() || v.e.is_some() || v.nu.is_some())
+        {
+            let s_nu = if v.nu.is_some() {
+                // ∂BLF/∂ν by a central difference of two re-solves (see the module docs).
+                let state = build_state(&cap.sections, &cap.frame, phi, s.index)?;
+                let mut mat = state_material_with(cap, options, s.index, green.as_ref());
+                let mut f = [0.0; 2];
+                for (k, sign) in [1.0, -1.0].into_iter().enumerate() {
+                    mat.poisson_ratio = v.nu0 + sign * NU_STEP;
+                    let b = state_buckling(&state, &mat, options)?;
+                    f[k] = b.factors.first().copied().unwrap_or(blf);
+                }
+                (f[0] - f[1]) / (2.0 * NU_STEP) / blf
+            } else {
+                0.0
+            };
+            checks.push(Check::Buckling { blf, s_nu });
+        }
+        if v.gamma.is_some() {
+            // A stress check is random only when its sign can change with γ > 0: σ_min < 0 and a
+            // compression above the deterministic tolerance; σ_max > 0 and a tension above it
+            // (with σ_max = 0 a tension fails, and round-off passes, whatever γ is).
+            if s.max_compression_stress_pa < -stol && k.sigma_min < 0.0 {
+                checks.push(Check::Compression(s.max_compression_stress_pa));
+            }
+            if s.max_tension_stress_pa > stol && k.sigma_max > 0.0 {
+                checks.push(Check::Tension(s.max_tension_stress_pa));
+            }
+            if let Some(u) = s.strength_utilisation.filter(|u| *u > 0.0) {
+                checks.push(Check::Strength(u));
+            }
+        }
+        out.push((s.index, t_hours, checks));
+    }
+    Ok(out)
+}
+
+fn rel_err(e: kappe_reliability::Error) -> DesignError {
+    DesignError::Uncertainty {
+        field: "uncertainty".into(),
+        message: format!("reliability analysis: {e}"),
+    }
+}
+
+/// FORM of `check` in `model` (the state's drifted model).
+pub fn check_form(
+    model: &Model,
+    check: Check,
+    v: Vars,
+    limits: (f64, f64, f64),
+) -> Result<FormResult, kappe_reliability::Error> {
+    let mut g = WithGradient(|x: &[f64], grad: &mut [f64]| limit_state(check, v, limits, x, grad));
+    form(model, &mut g, &FormOptions::default())
+}
+
+/// The reliability of every state of `analysis` and of the print; None without `[uncertainty]`.
+///
+/// # Errors
+/// An invalid `[uncertainty]`, a drift factor that reaches 0 within the print, a re-solve that
+/// fails, or FORM that does not converge ([`DesignError::Uncertainty`]).
+pub fn reliability(
+    cap: &Cap,
+    analysis: &Analysis,
+    schedule: &crate::schedule::Schedule,
+) -> Result<Option<Reliability>, DesignError> {
+    let Some(table) = &cap.design.uncertainty else {
+        return Ok(None);
+    };
+    let t0 = std::time::Instant::now();
+    let model = table.model(&cap.design)?;
+    let drifts = table.drifts();
+    let v = Vars::of(&model, cap);
+    let k = &cap.design.constraints;
+    let limits = (k.sigma_min, k.sigma_max, k.blf_min);
+    let per_state = state_checks(cap, analysis, schedule, v)?;
+    let mut components: Vec<Component> = Vec::new();
+    let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
+    let mut states = Vec::new();
+    for (index, t_hours, checks) in per_state {
+        if checks.is_empty() {
+            continue;
+        }
+        let state_model =
+            model
+                .drifted(&drifts, t_hours)
+                .map_err(|e| DesignError::Uncertainty {
+                    field: "uncertainty.drift".into(),
+                    message: format!("state {index} at {t_hours:.3} h: {e}"),
+                })?;
+        let mut by_check = BTreeMap::new();
+        let mut own = Vec::new();
+        for check in checks {
+            let r = check_form(&state_model, check, v, limits).map_err(rel_err)?;
+            by_check.insert(check.name().to_owned(), r.beta);
+            own.push(Component::from(&r));
+            results.push((index, check.name(), r));
+        }
+        let sys = series_system(
+            &own,
+            &SystemOptions {
+                samples: STATE_SYSTEM_SAMPLES,
+                seed: table.seed.unwrap_or(0),
+                ditlevsen: false,
+            },
+        )
+        .map_err(rel_err)?;
+        components.extend(own);
+        states.push(StateReliability {
+            index,
+            t_hours,
+            beta: sys.beta,
+            pf: sys.pf,
+            beta_by_check: by_check,
+        });
+    }
+    if components.is_empty() {
+        return Err(DesignError::Uncertainty {
+            field: "uncertainty".into(),
+            message: "no analysed check depends on the uncertain parameters (buckling needs an \
+                      analysed state; the stresses depend on material.specific_weight only)"
+                .into(),
+        });
+    }
+    let sys = series_system(
+        &components,
+        &SystemOptions {
+            samples: table.system_samples.unwrap_or(20_000),
+            seed: table.seed.unwrap_or(0),
+            ditlevsen: false,
+        },
+    )
+    .map_err(rel_err)?;
+    let Some((gov_state, gov_check, gov)) = results.get(sys.governing) else {
+        return Err(rel_err(kappe_reliability::Error::NoComponents));
+    };
+    let names = &gov.names;
+    let design_point = names.iter().cloned().zip(gov.x_star.clone()).collect();
+    let sensitivities = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            let get = |v: &[f64]| v.get(i).copied().unwrap_or(0.0);
+            (
+                n.clone(),
+                Sensitivity {
+                    importance: get(&gov.importance),
+                    dbeta_dmean: get(&gov.dbeta_dmean),
+                    dbeta_dstd: get(&gov.dbeta_dstd),
+                },
+            )
+        })
+        .collect();
+    Ok(Some(Reliability {
+        beta: sys.beta,
+        pf: sys.pf,
+        pf_interval: sys.interval,
+        beta_min: k.beta_min.unwrap_or(BETA_MIN_DEFAULT),
+        governing_state: *gov_state,
+        governing_check: (*gov_check).to_owned(),
+        design_point,
+        sensitivities,
+        states,
+        components: components.len(),
+        seconds: t0.elapsed().as_secs_f64(),
+    }))
+}

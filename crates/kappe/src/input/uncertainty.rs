@@ -1,0 +1,209 @@
+//! `[uncertainty]`: the design's uncertain parameters (issue 24), keyed by the design file's own
+//! names, their physical correlation and their drift over print time.
+//!
+//! ```toml
+//! [uncertainty]
+//! "material.specific_weight" = { dist = "normal", std = 1015.0 }
+//! "material.youngs_modulus" = { dist = "lognormal", cov = 0.2 }
+//!
+//! [uncertainty.correlation]
+//! "material.youngs_modulus" = { "material.specific_weight" = 0.3 }
+//!
+//! [uncertainty.drift]
+//! "material.youngs_modulus" = { percent_per_hour = -2.0 }
+//! ```
+//!
+//! Each entry is a [`kappe_reliability::UncertaintySpec`]; its mean is the design's value unless
+//! `mean` is given. The stiffness is declared positive, so it takes a lognormal or a uniform with
+//! lower bound > 0; the specific weight may be normal (the JCSS Probabilistic Model Code's model of
+//! self-weight; at the coefficients of variation of a mix, P(γ ≤ 0) is below 1e-20) and Poisson's
+//! ratio must stay in (0, 0.5), which a normal cannot guarantee, so it is declared positive too.
+
+use std::collections::BTreeMap;
+
+use kappe_reliability::{Correlation, Drift, Model, UncertaintySpec};
+use serde::{Deserialize, Serialize};
+
+use crate::input::design::Design;
+use crate::input::error::DesignError;
+
+/// Default β_min when the design has `[uncertainty]` and no `constraints.beta_min`: 2.3, P_f =
+/// Φ(−2.3) ≈ 1.1 %. ISO 2394:2015 Annex G and the JCSS Probabilistic Model Code (Part 1, Table
+/// 2.1) give β = 2.3 as the one-year target for a large relative cost of safety measures and
+/// minor consequences of failure — a temporary green-state print that fails in the lab.
+pub const BETA_MIN_DEFAULT: f64 = 2.3;
+
+/// The names `[uncertainty]` accepts, whether each is positive, and how it enters the analysis.
+pub const PARAMETERS: [(&str, bool); 3] = [
+    ("material.specific_weight", false),
+    ("material.youngs_modulus", true),
+    ("material.poisson_ratio", true),
+];
+
+/// The `[uncertainty]` table; see the module docs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct UncertaintyTable {
+    /// Physical correlation: `"a" = { "b" = ρ }`; pairs not listed are uncorrelated.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub correlation: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Drift of a parameter's mean and std over print time (%/h, steps).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub drift: BTreeMap<String, Drift>,
+    /// Number of importance samples of the print's series system (default 20 000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub system_samples: Option<u64>,
+    /// Seed of the series system's sampler (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// The uncertain parameters, by the design file's names.
+    #[serde(flatten)]
+    pub parameters: BTreeMap<String, UncertaintySpec>,
+}
+
+fn allowed_names() -> String {
+    PARAMETERS
+        .iter()
+        .map(|(n, _)| format!("\"{n}\""))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The design's nominal value of parameter `name`, or None for a name not in [`PARAMETERS`].
+pub fn nominal(design: &Design, name: &str) -> Option<f64> {
+    let m = &design.material;
+    match name {
+        "material.specific_weight" => Some(m.specific_weight),
+        "material.youngs_modulus" => Some(m.youngs_modulus),
+        "material.poisson_ratio" => Some(m.poisson_ratio),
+        _ => None,
+    }
+}
+
+fn err(field: String, e: impl std::fmt::Display) -> DesignError {
+    DesignError::Uncertainty {
+        field,
+        message: e.to_string(),
+    }
+}
+
+impl UncertaintyTable {
+    /// The reliability model: one random variable per entry (in name order), the correlation
+    /// mapped by Nataf; every problem a [`DesignError::Uncertainty`] naming the field.
+    pub fn model(&self, design: &Design) -> Result<Model, DesignError> {
+        if self.parameters.is_empty() {
+            return Err(err(
+                "uncertainty".into(),
+                format!(
+                    "no uncertain parameter given; allowed names: {}",
+                    allowed_names()
+                ),
+            ));
+        }
+        let known = |name: &str, context: &str| -> Result<(), DesignError> {
+            if nominal(design, name).is_some() {
+                Ok(())
+            } else {
+                Err(err(
+                    format!("{context}\"{name}\""),
+                    format!("unknown parameter; allowed names: {}", allowed_names()),
+                ))
+            }
+        };
+        let mut variables = Vec::with_capacity(self.parameters.len());
+        for (name, spec) in &self.parameters {
+            known(name, "uncertainty.")?;
+            let (_, positive) = PARAMETERS
+                .iter()
+                .find(|(n, _)| n == name)
+                .copied()
+                .unwrap_or((name, false));
+            let nominal = nominal(design, name).unwrap_or(0.0);
+            let v = spec
+                .to_variable(name, nominal, positive)
+                .map_err(|e| err(format!("uncertainty.\"{name}\""), e))?;
+            variables.push(v);
+        }
+        let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
+        if time_model && self.parameters.contains_key("material.youngs_modulus") {
+            return Err(err(
+                "uncertainty.\"material.youngs_modulus\"".into(),
+                "the design has a time model ([material.time] or [analysis.ageing]), whose \
+                 moduli do not use material.youngs_modulus; uncertainty of the time model's \
+                 parameters is not supported yet (issue 24)",
+            ));
+        }
+        let mut pairs = Vec::new();
+        for (a, row) in &self.correlation {
+            known(a, "uncertainty.correlation.")?;
+            for (b, &rho) in row {
+                known(b, &format!("uncertainty.correlation.\"{a}\"."))?;
+                for n in [a, b] {
+                    if !self.parameters.contains_key(n) {
+                        return Err(err(
+                            format!("uncertainty.correlation.\"{a}\".\"{b}\""),
+                            format!("`{n}` has no distribution in [uncertainty]; give it one"),
+                        ));
+                    }
+                }
+                pairs.push((a.clone(), b.clone(), rho));
+            }
+        }
+        for (name, d) in &self.drift {
+            known(name, "uncertainty.drift.")?;
+            if !self.parameters.contains_key(name) {
+                return Err(err(
+                    format!("uncertainty.drift.\"{name}\""),
+                    format!("`{name}` has no distribution in [uncertainty]; give it one"),
+                ));
+            }
+            if !d.percent_per_hour.is_finite()
+                || d.steps.iter().any(|s| {
+                    !(s.at_hours.is_finite()
+                        && s.at_hours >= 0.0
+                        && s.factor.is_finite()
+                        && s.factor > 0.0)
+                })
+            {
+                return Err(err(
+                    format!("uncertainty.drift.\"{name}\""),
+                    "allowed: a finite percent_per_hour; steps at_hours ≥ 0 with factor > 0",
+                ));
+            }
+        }
+        if self.system_samples.is_some_and(|n| n < 100) {
+            return Err(err(
+                "uncertainty.system_samples".into(),
+                "allowed: at least 100 samples",
+            ));
+        }
+        let correlation = if pairs.is_empty() {
+            Correlation::Independent
+        } else {
+            Correlation::Pairs(pairs)
+        };
+        Model::new(variables, &correlation).map_err(|e| {
+            let field = match &e {
+                kappe_reliability::Error::CorrelationNotPositiveDefinite { .. }
+                | kappe_reliability::Error::CorrelationOutOfRange { .. }
+                | kappe_reliability::Error::CorrelationNotAttainable { .. }
+                | kappe_reliability::Error::CorrelationNotSymmetric { .. } => {
+                    "uncertainty.correlation".to_owned()
+                }
+                kappe_reliability::Error::NotPositive { variable, .. }
+                | kappe_reliability::Error::InvalidParameter { variable, .. } => {
+                    format!("uncertainty.\"{variable}\"")
+                }
+                _ => "uncertainty".to_owned(),
+            };
+            err(field, e)
+        })
+    }
+
+    /// The drifts as the engine takes them.
+    pub fn drifts(&self) -> Vec<(String, Drift)> {
+        self.drift
+            .iter()
+            .map(|(n, d)| (n.clone(), d.clone()))
+            .collect()
+    }
+}

@@ -1,0 +1,183 @@
+//! Reliability of the print states under `[uncertainty]` (issue 24): named errors for bad input,
+//! the exact scalings against a re-solve, FORM against Monte Carlo, and no change without the
+//! table.
+
+use kappe::analysis::reliability::{Check, Vars, check_form, limit_state};
+use kappe::analysis::{AnalysisOptions, StateSelection, state_buckling, state_material};
+use kappe::form::states::build_state;
+use kappe::{Design, Options, design_cap, no_progress, run};
+use kappe_reliability::{SamplingOptions, WithGradient, monte_carlo};
+
+/// Final state only, 8 layers per mesh row (as `analysis.rs`'s `final_coarse`).
+fn small() -> Design {
+    let mut d = Design::default();
+    d.cap.length = 0.15;
+    d.print.path_sampling = 0.04;
+    d.robot.enabled = false;
+    d.analysis = AnalysisOptions {
+        states: StateSelection::Every(usize::MAX),
+        row_stride: 8,
+        ..AnalysisOptions::default()
+    };
+    d
+}
+
+fn with_uncertainty(extra: &str) -> Result<Design, kappe::DesignError> {
+    Design::from_toml_str(&format!("name = \"u\"\n{extra}"))
+}
+
+#[test]
+fn bad_uncertainty_is_a_named_error() {
+    let cases = [
+        (
+            "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", std = -5.0 }\n",
+            "material.youngs_modulus",
+        ),
+        (
+            "[uncertainty]\n\"material.colour\" = { dist = \"normal\", std = 1.0 }\n",
+            "material.specific_weight",
+        ),
+        (
+            "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"normal\", cov = 0.1 }\n",
+            "positive",
+        ),
+        (
+            "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.1 }\n\
+             \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+             \"material.poisson_ratio\" = { dist = \"lognormal\", cov = 0.05 }\n\
+             [uncertainty.correlation]\n\
+             \"material.youngs_modulus\" = { \"material.specific_weight\" = 0.9, \"material.poisson_ratio\" = 0.9 }\n\
+             \"material.specific_weight\" = { \"material.poisson_ratio\" = -0.9 }\n",
+            "uncertainty.correlation",
+        ),
+    ];
+    for (text, needle) in cases {
+        let e = with_uncertainty(text).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            matches!(
+                e,
+                kappe::DesignError::Uncertainty { .. } | kappe::DesignError::Parse { .. }
+            ),
+            "{msg}"
+        );
+        assert!(msg.contains(needle), "`{needle}` not in: {msg}");
+        assert!(msg.contains("uncertainty"), "no field named: {msg}");
+    }
+}
+
+/// BLF ∝ E/γ with a uniform E: the shortcut against a re-solve of the shell with E×1.3, γ×0.8.
+#[test]
+fn buckling_scaling_matches_a_resolve() {
+    let d = small();
+    let cap = design_cap(&d, &|_| {}).unwrap();
+    let o = d.analysis.clone();
+    let last = cap.states.len() - 1;
+    let state = build_state(&cap.sections, &cap.frame, 0.0, last).unwrap();
+    let mut mat = state_material(&cap, &o, last).unwrap();
+    let blf0 = state_buckling(&state, &mat, &o).unwrap().factors[0];
+    mat.youngs_modulus *= 1.3;
+    mat.unit_weight *= 0.8;
+    let blf1 = state_buckling(&state, &mat, &o).unwrap().factors[0];
+    let table = with_uncertainty(
+        "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.2 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n",
+    )
+    .unwrap()
+    .uncertainty
+    .unwrap();
+    let model = table.model(&d).unwrap();
+    let v = Vars::of(&model, &cap);
+    // Variables are in name order: specific_weight, youngs_modulus.
+    let x = [
+        d.material.specific_weight * 0.8,
+        d.material.youngs_modulus * 1.3,
+    ];
+    let mut grad = [0.0; 2];
+    let g = limit_state(
+        Check::Buckling {
+            blf: blf0,
+            s_nu: 0.0,
+        },
+        v,
+        (-1.0, 0.0, 1.0),
+        &x,
+        &mut grad,
+    );
+    // 1e-6 relative: the eigensolver converges each factor to a relative residual ≪ 1e-6, and
+    // the scaling is exact (K ∝ E, K_G ∝ γ), so only solver round-off separates the two.
+    assert!(
+        ((g + 1.0) / blf1 - 1.0).abs() < 1e-6,
+        "scaled {} vs re-solved {blf1}",
+        g + 1.0
+    );
+}
+
+/// FORM of a buckling limit state with the exact scalings against crude Monte Carlo of the same
+/// g, 2·10⁴ seeded samples: the FORM P_f must lie in the 95 % (Wilson) interval.
+#[test]
+fn form_agrees_with_monte_carlo() {
+    let d = small();
+    let cap = design_cap(&d, &|_| {}).unwrap();
+    let table = with_uncertainty(
+        "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.35 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n",
+    )
+    .unwrap()
+    .uncertainty
+    .unwrap();
+    let model = table.model(&d).unwrap();
+    let v = Vars::of(&model, &cap);
+    // BLF₀ = 1.6 against BLF_min = 1: P_f ≈ 9 %, where 2·10⁴ samples resolve it to ±5 %.
+    let check = Check::Buckling {
+        blf: 1.6,
+        s_nu: 0.0,
+    };
+    let limits = (-2.0e4, 0.0, 1.0);
+    let r = check_form(&model, check, v, limits).unwrap();
+    let mut g = WithGradient(|x: &[f64], grad: &mut [f64]| limit_state(check, v, limits, x, grad));
+    let mc = monte_carlo(&model, &mut g, &SamplingOptions::new(20_000, 7)).unwrap();
+    assert!(
+        mc.interval[0] <= r.pf && r.pf <= mc.interval[1],
+        "FORM P_f {} outside the MC interval {:?} (MC P_f {})",
+        r.pf,
+        mc.interval,
+        mc.pf
+    );
+}
+
+/// Without `[uncertainty]` nothing changes: no reliability, no new keys in summary.json; with
+/// it the print gets a finite β and the analysed state its β per check.
+#[test]
+fn reliability_only_with_the_table() {
+    let d = small();
+    let out = run(&d, &Options::of(&d), &no_progress).unwrap();
+    assert!(out.reliability.is_none());
+    let json = serde_json::to_string(&out.summary()).unwrap();
+    for key in ["\"reliability\"", "\"beta\"", "\"pf\"", "\"beta_by_check\""] {
+        assert!(
+            !json.contains(key),
+            "{key} in the summary without [uncertainty]"
+        );
+    }
+    let mut du = d.clone();
+    du.uncertainty = with_uncertainty(
+        "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.3 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n",
+    )
+    .unwrap()
+    .uncertainty;
+    let out_u = run(&du, &Options::of(&du), &no_progress).unwrap();
+    let r = out_u.reliability.as_ref().unwrap();
+    assert!(r.beta.is_finite() && r.pf > 0.0 && r.pf < 1.0, "{r:?}");
+    let last = r
+        .states
+        .iter()
+        .find(|s| s.beta_by_check.contains_key("buckling"));
+    assert!(last.is_some(), "no buckling check in {:?}", r.states);
+    // The deterministic results are the same run's.
+    assert_eq!(
+        out.analysis.as_ref().map(|a| a.constraints.clone()),
+        out_u.analysis.as_ref().map(|a| a.constraints.clone())
+    );
+}
