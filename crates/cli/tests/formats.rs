@@ -122,3 +122,25 @@ fn ceiling_example_is_documented() {
             .contains("[[bay]]")
     );
 }
+
+#[test]
+fn moving_example_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = init(tmp.path(), "moving");
+    let o = kappe(
+        tmp.path(),
+        &["design", &file, "--out", "o", "--quiet", "--allow-fail"],
+    );
+    let out = tmp.path().join("o");
+    ran(&o, &out, "base_trajectory.csv");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert!(s["robot"]["base_trajectory"]["length_m"].as_f64().unwrap() > 0.0);
+    let head = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    assert!(
+        head.lines()
+            .next()
+            .unwrap()
+            .ends_with("base_x,base_y,base_yaw")
+    );
+}

@@ -124,6 +124,22 @@ pub fn plan_robot_with_waits(
     Ok(plan)
 }
 
+/// Plan the robot with the base moving while it prints (issue 27, `[robot.base] mode =
+/// "moving"`): `kappe_robot::plan_moving` on the same layers, cell and options as
+/// [`plan_robot_with_waits`]. The returned plan's `plan` is an ordinary [`Plan`] with one
+/// station (the base at travel 0) on the moving clock, so the schedule and the summary read it
+/// as any plan. UR's collision meshes are not attached: their report poses the arm from fixed
+/// stations, which a moving base has not (the moving check certifies the capsules along every
+/// move with arm and base moving together instead).
+pub fn plan_robot_moving(
+    cap: &Cap,
+    base: &kappe_robot::MovingBase,
+    waits: Option<&[kappe_robot::LayerWait]>,
+) -> Result<kappe_robot::MovingPlan, kappe_robot::RobotError> {
+    let (setup, opts) = robot_inputs(cap);
+    kappe_robot::plan_moving(&print_layers(&cap.path), &setup, &opts, base, waits)
+}
+
 /// When each layer is printed on the plan's clock (start = arrival at its first target, end =
 /// arrival at its last, and the wait and whole pause after it): the times the programs and
 /// `trajectory.csv` use, for the structural schedule.

@@ -124,8 +124,14 @@ pub struct Outcome {
     /// The robot plan, or why there is none; `None` when planning was not asked for (or the
     /// design disables the robot).
     pub robot: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
+    /// The moving-base part of the plan (issue 27) when `[robot.base] mode = "moving"` and it
+    /// planned: the base trajectory and the tracking simulation. `robot` then holds its arm
+    /// plan (`MovingRun::plan.plan`), so the schedule, the summary and the verdict read it as
+    /// any plan.
+    pub moving: Option<MovingRun>,
     /// The base-pose tolerance check of the plan (`[robot.tolerance]`, issue 15); `None`
-    /// without a plan or with `check = false`.
+    /// without a plan or with `check = false`. For a moving plan it is
+    /// `kappe_robot::check_moving_tolerance` (the base off its trajectory by the same errors).
     pub base_tolerance: Option<kappe_robot::tolerance::ToleranceReport>,
     /// The one schedule of the run (issue 11): every layer's start, end, wait and station
     /// change on the robot plan's clock when there is a plan, else from path length / print
@@ -141,6 +147,24 @@ pub struct Outcome {
     pub verdict: Verdict,
     /// [`Options::allow_fail`] of the run.
     pub allow_fail: bool,
+}
+
+/// The moving-base results of a run (issue 27).
+#[derive(Debug)]
+pub struct MovingRun {
+    /// The moving plan: the arm plan, the base trajectory, the lead and reach margin.
+    pub plan: kappe_robot::MovingPlan,
+    /// The controller's conveyor tracking simulated under the base's expected errors
+    /// (`kappe_robot::simulate_tracking` with its documented default errors and tolerance), or
+    /// why it could not run.
+    pub tracking: Result<kappe_robot::TrackingReport, String>,
+}
+
+impl MovingRun {
+    /// Whether the tracking simulation ran and kept the nozzle within its tolerance.
+    pub fn tracking_ok(&self) -> bool {
+        self.tracking.as_ref().is_ok_and(|r| r.problems.is_empty())
+    }
 }
 
 /// Form-find `design`, then [`evaluate`] it. `on_progress` hears every state solved, every
@@ -192,6 +216,26 @@ fn evaluate_until(
     } else {
         None
     };
+    // A moving plan hands its arm plan to the rest of the run and keeps the base's part.
+    let (robot, moving) = match robot {
+        Some(Planned::Moving(m)) => match m {
+            Ok(mp) => {
+                let tracking = kappe_robot::simulate_tracking(
+                    &mp,
+                    &kappe_robot::TrackingErrors::default(),
+                    &kappe_robot::TrackingTolerance::default(),
+                )
+                .map_err(|e| e.to_string());
+                (
+                    Some(Ok(mp.plan.clone())),
+                    Some(MovingRun { plan: mp, tracking }),
+                )
+            }
+            Err(e) => (Some(Err(e)), None),
+        },
+        Some(Planned::Stations(p)) => (Some(p), None),
+        None => (None, None),
+    };
     check(stop)?;
     let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
@@ -215,8 +259,12 @@ fn evaluate_until(
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
     let tol = &cap.design.robot.tolerance;
-    let base_tolerance = match &robot {
-        Some(Ok(plan)) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
+    let base_tolerance = match (&robot, &moving) {
+        (Some(Ok(_)), Some(m)) if tol.check => Some(kappe_robot::check_moving_tolerance(
+            &m.plan,
+            &tol.base_tolerance(),
+        )),
+        (Some(Ok(plan)), None) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
             plan,
             &tol.base_tolerance(),
         )),
@@ -228,6 +276,7 @@ fn evaluate_until(
         RobotResults {
             plan: robot.as_ref(),
             tolerance: base_tolerance.as_ref(),
+            tracking: moving.as_ref().map(|m| &m.tracking),
         },
     );
     if let Some(r) = &reliability
@@ -256,6 +305,7 @@ fn evaluate_until(
         cap,
         robot,
         reliability,
+        moving,
         base_tolerance,
         schedule,
         analysis,
@@ -330,15 +380,29 @@ fn run_schedule(
     Ok(schedule)
 }
 
+/// A plan from stations or with the base moving.
+// Both variants are large; the value lives only from planning to the next statement, so the
+// size difference costs one move.
+#[allow(clippy::large_enum_variant)]
+enum Planned {
+    Stations(Result<kappe_robot::Plan, kappe_robot::RobotError>),
+    Moving(Result<kappe_robot::MovingPlan, kappe_robot::RobotError>),
+}
+
 /// Plan the robot with the design's `[schedule]` waits (so the printed schedule is the checked
 /// one: the waits become pauses in the programs), or with the planner's own minimum layer time
-/// when the design sets none.
-fn plan_with_schedule_waits(
-    cap: &Cap,
-) -> Result<Result<kappe_robot::Plan, kappe_robot::RobotError>, DesignError> {
+/// when the design sets none; from stations or with the base moving (`[robot.base]`).
+fn plan_with_schedule_waits(cap: &Cap) -> Result<Planned, DesignError> {
     let waits = cap.design.schedule.waits(cap.sections.layers.len())?;
+    let moving = match &cap.design.robot.base {
+        kappe_robot::BaseMode::Moving(m) => Some(m),
+        kappe_robot::BaseMode::Stations => None,
+    };
     if waits.iter().all(|w| *w == 0.0) {
-        return Ok(crate::robot_plan::plan_robot(cap));
+        return Ok(match moving {
+            Some(m) => Planned::Moving(crate::robot_plan::plan_robot_moving(cap, m, None)),
+            None => Planned::Stations(crate::robot_plan::plan_robot(cap)),
+        });
     }
     let layers = crate::robot_plan::print_layers(&cap.path);
     let given: Vec<kappe_robot::LayerWait> = layers
@@ -349,5 +413,8 @@ fn plan_with_schedule_waits(
             wait: *w,
         })
         .collect();
-    Ok(crate::robot_plan::plan_robot_with_waits(cap, Some(&given)))
+    Ok(match moving {
+        Some(m) => Planned::Moving(crate::robot_plan::plan_robot_moving(cap, m, Some(&given))),
+        None => Planned::Stations(crate::robot_plan::plan_robot_with_waits(cap, Some(&given))),
+    })
 }

@@ -66,6 +66,16 @@ pub enum Failure {
         /// The first problem found.
         problem: String,
     },
+    /// The moving base's conveyor-tracking simulation (issue 27) keeps the nozzle outside its
+    /// tolerance, or could not run.
+    BaseTracking {
+        /// Largest nozzle-to-path deviation found, m (None when the simulation did not run).
+        max_deviation_m: Option<f64>,
+        /// Largest deviation allowed, m (None when the simulation did not run).
+        allowed_m: Option<f64>,
+        /// The first problem found.
+        problem: String,
+    },
 }
 
 impl std::fmt::Display for Failure {
@@ -98,6 +108,10 @@ impl std::fmt::Display for Failure {
                  tolerance to match, or widen the base search ([robot.setup.base])",
                 position_m * 1e3
             ),
+            Failure::BaseTracking { problem, .. } => write!(
+                f,
+                "the arm does not track the moving base within tolerance: {problem}"
+            ),
         }
     }
 }
@@ -109,6 +123,8 @@ pub struct RobotResults<'a> {
     pub plan: Option<&'a Result<kappe_robot::Plan, kappe_robot::RobotError>>,
     /// The base-pose tolerance check of the plan, when run.
     pub tolerance: Option<&'a kappe_robot::tolerance::ToleranceReport>,
+    /// The moving base's tracking simulation, when the base moves (issue 27).
+    pub tracking: Option<&'a Result<kappe_robot::TrackingReport, String>>,
 }
 
 /// The verdict of a run: the analysis' constraints (or the [`preliminary_constraints`] without
@@ -149,6 +165,26 @@ pub fn verdict(cap: &Cap, analysis: Option<&Analysis>, robot: RobotResults<'_>) 
                     yaw_deg: tol.yaw_deg,
                     problem: r.problems.first().cloned().unwrap_or_default(),
                 });
+            }
+            // The tracking simulation is a tolerance check too: in the verdict on the same
+            // switch as the base-pose check.
+            let tracking_failure = match robot.tracking {
+                Some(Err(why)) => Some(Failure::BaseTracking {
+                    max_deviation_m: None,
+                    allowed_m: None,
+                    problem: why.clone(),
+                }),
+                Some(Ok(r)) if !r.problems.is_empty() => Some(Failure::BaseTracking {
+                    max_deviation_m: Some(r.max_deviation),
+                    allowed_m: Some(r.max_deviation_allowed),
+                    problem: r.problems[0].clone(),
+                }),
+                _ => None,
+            };
+            if tol.verdict
+                && let Some(f) = tracking_failure
+            {
+                failures.push(f);
             }
         }
         None => {}
@@ -338,6 +374,7 @@ mod tests {
             RobotResults {
                 plan: Some(&plan),
                 tolerance: None,
+                tracking: None,
             },
         );
         assert!(!v.ok);

@@ -3,13 +3,14 @@
 //! examples, the docs and the readers cannot drift apart.
 
 /// The kinds of example file, with the text `kappe init --kind` writes.
-pub const KINDS: [(&str, &str); 6] = [
+pub const KINDS: [(&str, &str); 7] = [
     ("design", crate::input::design::EXAMPLE_TOML),
     ("study", STUDY_TOML),
     ("prototypes", PROTOTYPES_TOML),
     ("optimize", OPTIMIZE_TOML),
     ("buildability", crate::commands::buildability::EXAMPLE_TOML),
     ("ceiling", crate::commands::ceiling::EXAMPLE_TOML),
+    ("moving", MOVING_TOML),
 ];
 
 /// A design study (`kappe study`): a 2 × 2 grid of short caps.
@@ -18,6 +19,9 @@ pub const STUDY_TOML: &str = include_str!("templates/study.toml");
 pub const PROTOTYPES_TOML: &str = include_str!("templates/prototypes.toml");
 /// The design loop (`kappe optimize`).
 pub const OPTIMIZE_TOML: &str = include_str!("templates/optimize.toml");
+
+/// A design printed in one take while the base moves (issue 27): a 1.5 m × 4 m bay.
+pub const MOVING_TOML: &str = include_str!("templates/moving.toml");
 
 /// The example text of `kind`, if it is one of [`KINDS`].
 ///

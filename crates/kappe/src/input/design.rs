@@ -118,11 +118,104 @@ pub struct RobotSpec {
     pub beams: BeamSpec,
     /// Robot cell: base placement, tool, mobile base, floor, extra obstacles.
     pub setup: kappe_robot::setup::RobotSetup,
+    /// How the base takes part in the print (issue 27): `[robot.base] mode = "stations"` (the
+    /// default: print, stop, drive, re-localise; `setup.base` places the stations) or
+    /// `mode = "moving"` (the base creeps along the bay while the arm prints, one take). A
+    /// table of its own rather than a field of `[robot.setup]`: `setup.base` already names the
+    /// station placement. The moving limits and their defaults are `kappe_robot::MovingBase`'s:
+    /// `speed_max` 0.1 m/s, `accel_max` 0.1 m/s², `x` 0 m, `z` 0 m, `yaw_deg` 270°, `lead`
+    /// searched in `lead_range` 0.3–1.6 m by `lead_step` 0.02 m, `min_reach_margin` 0.02 m,
+    /// `score_layers` 40, `score_stride` 5, `body_check_step` 0.01 m.
+    #[serde(skip_serializing_if = "is_stations")]
+    pub base: kappe_robot::BaseMode,
     /// Planner settings.
     pub plan: kappe_robot::setup::PlanOptions,
     /// The base-pose tolerance check of the plan (issue 15): `[robot.tolerance]`.
     #[serde(skip_serializing_if = "ToleranceSpec::is_default")]
     pub tolerance: ToleranceSpec,
+}
+
+/// Whether the base mode is the default (kept out of resolved design files and summaries, so a
+/// station design's outputs do not change).
+fn is_stations(m: &kappe_robot::BaseMode) -> bool {
+    *m == kappe_robot::BaseMode::Stations
+}
+
+/// Check the moving-base settings of `[robot.base]`, each error naming its field.
+fn validate_moving(m: &kappe_robot::MovingBase) -> Result<(), DesignError> {
+    let check = |field: &'static str, value: f64, ok: bool, allowed: &str| {
+        if value.is_finite() && ok {
+            Ok(())
+        } else {
+            Err(DesignError::Invalid {
+                field,
+                value: format!("{value}"),
+                allowed: allowed.to_string(),
+            })
+        }
+    };
+    check(
+        "robot.base.speed_max",
+        m.speed_max,
+        m.speed_max > 0.0,
+        "allowed: speed_max > 0 m/s",
+    )?;
+    check(
+        "robot.base.accel_max",
+        m.accel_max,
+        m.accel_max > 0.0,
+        "allowed: accel_max > 0 m/s²",
+    )?;
+    check("robot.base.x", m.x, true, "allowed: a finite x, m")?;
+    check("robot.base.z", m.z, true, "allowed: a finite z, m")?;
+    check(
+        "robot.base.yaw_deg",
+        m.yaw_deg,
+        true,
+        "allowed: a finite yaw, degrees",
+    )?;
+    let [lo, hi] = m.lead_range;
+    if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
+        return Err(DesignError::Invalid {
+            field: "robot.base.lead_range",
+            value: format!("[{lo}, {hi}]"),
+            allowed: "allowed: [min, max] with 0 ≤ min < max, m".into(),
+        });
+    }
+    check(
+        "robot.base.lead_step",
+        m.lead_step,
+        m.lead_step > 0.0,
+        "allowed: lead_step > 0 m",
+    )?;
+    if let Some(l) = m.lead {
+        check("robot.base.lead", l, l >= 0.0, "allowed: lead ≥ 0 m")?;
+    }
+    check(
+        "robot.base.min_reach_margin",
+        m.min_reach_margin,
+        m.min_reach_margin >= 0.0,
+        "allowed: min_reach_margin ≥ 0 m",
+    )?;
+    check(
+        "robot.base.body_check_step",
+        m.body_check_step,
+        m.body_check_step > 0.0,
+        "allowed: body_check_step > 0 m",
+    )?;
+    for (field, n) in [
+        ("robot.base.score_layers", m.score_layers),
+        ("robot.base.score_stride", m.score_stride),
+    ] {
+        if n == 0 {
+            return Err(DesignError::Invalid {
+                field,
+                value: "0".into(),
+                allowed: "allowed: ≥ 1".into(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// `[robot.tolerance]`: the base-pose errors a relocated mobile base must tolerate
@@ -202,6 +295,7 @@ impl Default for RobotSpec {
             enabled: true,
             beams: BeamSpec::default(),
             setup: kappe_robot::setup::RobotSetup::default(),
+            base: kappe_robot::BaseMode::Stations,
             plan: kappe_robot::setup::PlanOptions::default(),
             tolerance: ToleranceSpec::default(),
         }
@@ -540,6 +634,9 @@ impl Design {
                           move and a retract)"
                     .into(),
             });
+        }
+        if let kappe_robot::BaseMode::Moving(m) = &self.robot.base {
+            validate_moving(m)?;
         }
         Ok(())
     }

@@ -63,6 +63,62 @@ pub fn plan_files(plan: &Plan, prefix: &str, programs: bool) -> Result<Vec<Outpu
         .collect())
 }
 
+/// The outputs of a moving-base plan (issue 27): `trajectory.csv` with the base pose
+/// (`base_x, base_y, base_yaw`, world, m and rad) on every row, `plan.json`,
+/// `base_trajectory.csv` and `base_trajectory.json` (what the base follows), and when `programs`
+/// the conveyor-tracking program files, each passing `kappe_robot::lint_tracking` against the
+/// plan's target limit, and their index `programs.json` (`kappe_robot::tracking_index_json`).
+///
+/// # Errors
+/// [`OutputError::Produce`] when a program fails the tracking lint or a writer fails.
+pub fn moving_plan_files(
+    mp: &kappe_robot::MovingPlan,
+    prefix: &str,
+    programs: bool,
+) -> Result<Vec<OutputFile>> {
+    let produce = |e: kappe_robot::RobotError| OutputError::Produce(format!("robot outputs: {e}"));
+    // plan.json is the whole moving plan (arm plan, base trajectory, lead): the station writer
+    // verifies its plan from fixed stations, which a moving plan is not.
+    let mut out = vec![
+        OutputFile::new("trajectory.csv", mp.trajectory_csv()),
+        json("plan.json", mp)?,
+    ];
+    out.push(OutputFile::new(
+        "base_trajectory.csv",
+        mp.trajectory.to_csv(),
+    ));
+    out.push(OutputFile::new(
+        "base_trajectory.json",
+        mp.trajectory.to_json(),
+    ));
+    if programs {
+        let files = kappe_robot::tracking_program_files(
+            mp,
+            &kappe_robot::ConveyorOptions::default(),
+            prefix,
+        )
+        .map_err(produce)?;
+        let max = mp.plan.options.program.max_moves_per_program;
+        let limits = mp.plan.options.limits.position();
+        for (f, _) in &files {
+            let rep = kappe_robot::lint_tracking(&f.text, max, &limits);
+            if !rep.ok() {
+                return Err(OutputError::Produce(format!(
+                    "{} fails the URScript check: {}",
+                    f.name,
+                    rep.problems.join("; ")
+                )));
+            }
+            out.push(OutputFile::new(f.name.clone(), f.text.clone()));
+        }
+        out.push(OutputFile::new(
+            "programs.json",
+            kappe_robot::tracking_index_json(&files),
+        ));
+    }
+    Ok(out)
+}
+
 impl Outcome {
     /// Every file `kappe design` writes for this outcome: `summary.json`, `network.json`,
     /// `path.csv`, `cap.obj`, `cap.glb`, `report.html`, `schedule.csv`, and with a robot plan
@@ -92,21 +148,29 @@ impl Outcome {
         ];
         // The layer times the structural check and the robot share (issue 11).
         out.push(OutputFile::new("schedule.csv", self.schedule.to_csv()));
-        if let Some(Ok(plan)) = &self.robot {
-            let plan = self.marked_plan(plan);
-            let programs = self.programs();
-            out.extend(plan_files(&plan, "program_part", programs.is_ok())?);
-            // The operator's station sheet (issue 28): base pose, tolerance, layers, programs
-            // and time per station.
-            let sheet = kappe_robot::stations::station_sheet(
-                &plan,
-                self.base_tolerance.as_ref(),
-                programs
-                    .as_ref()
-                    .map(|_| "program_part")
-                    .map_err(String::as_str),
-            );
-            out.push(OutputFile::new("stations.md", sheet));
+        match (&self.robot, &self.moving) {
+            (Some(Ok(_)), Some(m)) => out.extend(moving_plan_files(
+                &m.plan,
+                "program_part",
+                self.programs().is_ok(),
+            )?),
+            (Some(Ok(plan)), None) => {
+                let plan = self.marked_plan(plan);
+                let programs = self.programs();
+                out.extend(plan_files(&plan, "program_part", programs.is_ok())?);
+                // The operator's station sheet (issue 28): base pose, tolerance, layers,
+                // programs and time per station.
+                let sheet = kappe_robot::stations::station_sheet(
+                    &plan,
+                    self.base_tolerance.as_ref(),
+                    programs
+                        .as_ref()
+                        .map(|_| "program_part")
+                        .map_err(String::as_str),
+                );
+                out.push(OutputFile::new("stations.md", sheet));
+            }
+            _ => {}
         }
         Ok(out)
     }

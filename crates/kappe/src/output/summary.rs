@@ -278,6 +278,62 @@ pub struct PlanSummary {
     /// The base-pose tolerance check (absent when not run).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub base_tolerance: Option<BaseToleranceSummary>,
+    /// The moving base (issue 27; absent for a station plan).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base_trajectory: Option<BaseTrajectorySummary>,
+}
+
+/// The base trajectory of a moving-base plan (`base_trajectory.csv`) and its tracking
+/// simulation.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct BaseTrajectorySummary {
+    /// Rows of `base_trajectory.csv`.
+    pub samples: usize,
+    /// Total base travel along the bay, m.
+    pub length_m: f64,
+    /// From the first row to the last, s.
+    pub duration_s: f64,
+    /// Largest base speed, m/s.
+    pub max_speed_m_s: f64,
+    /// Largest base acceleration, m/s².
+    pub max_acceleration_m_s2: f64,
+    /// Mean speed while the arm prints, m/s.
+    pub mean_moving_speed_m_s: f64,
+    /// Time the base holds still, s.
+    pub hold_time_s: f64,
+    /// Lead of the base ahead of the printing front, m.
+    pub lead_m: f64,
+    /// Along-bay reach margin of the lead, m (null for a lead given in the design).
+    pub reach_margin_m: Option<f64>,
+    /// The conveyor-tracking simulation under the base's expected errors.
+    pub tracking: TrackingSummary,
+}
+
+/// The conveyor-tracking simulation (`kappe_robot::simulate_tracking`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct TrackingSummary {
+    /// The simulation ran and the nozzle stayed within every tolerance.
+    pub ok: bool,
+    /// Largest nozzle-to-path deviation, m (null when the simulation did not run).
+    pub max_deviation_m: Option<f64>,
+    /// Largest deviation allowed, m.
+    pub max_deviation_allowed_m: Option<f64>,
+    /// Where the largest deviation is: layer id, point index, plan time (s).
+    pub at_layer: Option<i64>,
+    /// Point index of the largest deviation.
+    pub at_index: Option<usize>,
+    /// Plan time of the largest deviation, s.
+    pub at_t_s: Option<f64>,
+    /// Largest shift across the shell relative to the layer below, m.
+    pub max_relative_across_m: Option<f64>,
+    /// Largest shift along the tool axis relative to the layer below, m.
+    pub max_relative_axial_m: Option<f64>,
+    /// Largest distance of the base from its planned pose, m.
+    pub max_base_offset_m: Option<f64>,
+    /// What failed (or why the simulation did not run).
+    pub problems: Vec<String>,
+    /// Whether a failure fails the design (`[robot.tolerance] verdict`).
+    pub in_verdict: bool,
 }
 
 /// One base station.
@@ -508,8 +564,59 @@ impl Outcome {
                         problems: t.problems.clone(),
                         in_verdict: self.cap.design.robot.tolerance.verdict,
                     }),
+                    base_trajectory: self
+                        .moving
+                        .as_ref()
+                        .map(|m| self.base_trajectory_summary(m)),
                 }),
             },
+        }
+    }
+}
+
+impl Outcome {
+    fn base_trajectory_summary(&self, m: &crate::run::MovingRun) -> BaseTrajectorySummary {
+        let b = m.plan.trajectory.summary();
+        let in_verdict = self.cap.design.robot.tolerance.verdict;
+        let tracking = match &m.tracking {
+            Ok(r) => TrackingSummary {
+                ok: r.problems.is_empty(),
+                max_deviation_m: Some(r.max_deviation),
+                max_deviation_allowed_m: Some(r.max_deviation_allowed),
+                at_layer: Some(r.at.0),
+                at_index: Some(r.at.1),
+                at_t_s: Some(r.at.2),
+                max_relative_across_m: Some(r.max_relative_across),
+                max_relative_axial_m: Some(r.max_relative_axial),
+                max_base_offset_m: Some(r.max_base_offset),
+                problems: r.problems.clone(),
+                in_verdict,
+            },
+            Err(why) => TrackingSummary {
+                ok: false,
+                max_deviation_m: None,
+                max_deviation_allowed_m: None,
+                at_layer: None,
+                at_index: None,
+                at_t_s: None,
+                max_relative_across_m: None,
+                max_relative_axial_m: None,
+                max_base_offset_m: None,
+                problems: vec![why.clone()],
+                in_verdict,
+            },
+        };
+        BaseTrajectorySummary {
+            samples: b.samples,
+            length_m: b.travel,
+            duration_s: b.end - b.start,
+            max_speed_m_s: b.max_speed,
+            max_acceleration_m_s2: b.max_acceleration,
+            mean_moving_speed_m_s: b.mean_moving_speed,
+            hold_time_s: b.hold_time,
+            lead_m: m.plan.lead,
+            reach_margin_m: m.plan.reach_margin,
+            tracking,
         }
     }
 }

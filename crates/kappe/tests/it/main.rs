@@ -8,6 +8,7 @@ mod ceiling;
 mod ends;
 mod floors;
 mod green_state;
+mod moving;
 mod readers_fuzz;
 mod reliability;
 mod scale;
