@@ -2,11 +2,22 @@
 
 use thiserror::Error;
 
+/// The text of [`DesignError::Parse`]: the entry when there is one. Every TOML file Kappe
+/// reads goes through the same parser, so the message does not claim it is a design file (the
+/// command names the file).
+fn parse_message(path: &str, message: &str) -> String {
+    if path.is_empty() {
+        message.to_string()
+    } else {
+        format!("`{path}`: {message}")
+    }
+}
+
 /// Everything that can go wrong between a design file and a finished cap.
 #[derive(Debug, Error)]
 pub enum DesignError {
     /// The design file is not valid TOML or does not match the schema (unknown field, wrong type).
-    #[error("design file: {path}: {message}")]
+    #[error("{}", parse_message(.path, .message))]
     Parse {
         /// Dotted path of the offending entry (empty for a syntax error).
         path: String,
