@@ -2,9 +2,10 @@ import json
 import math
 import subprocess
 
+import jsonschema
 import numpy as np
 import pytest
-from conftest import CHEAP
+from conftest import CHEAP, ROOT
 
 import kappe
 
@@ -99,10 +100,6 @@ def test_default_designs_summary_matches_its_published_schema(tmp_path, kappe_bi
     """Issue 22: summary.json of the default design (`kappe design`, robot and every state)
     validates against docs/formats/summary.schema.json, the schema generated from the typed
     summary; an output missing a required field or with a wrong type would fail here."""
-    import jsonschema
-
-    from conftest import ROOT
-
     schema = json.loads((ROOT / "docs" / "formats" / "summary.schema.json").read_text())
     out = tmp_path / "out"
     subprocess.run([kappe_bin, "design", "--out", str(out), "-q", "--allow-fail"], check=True)
