@@ -108,8 +108,23 @@ impl Symbolic {
         p: &Pattern,
         vals: &[f64],
     ) -> Result<Option<usize>, FeError> {
+        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (Sturm check)")? else {
+            return Ok(None);
+        };
+        Ok(self.count_negative(&l))
+    }
+
+    /// The numeric LDLᵀ values (no pivoting) of the matrix with lower values `vals`; `None` when
+    /// faer rejects the factorization (a zero pivot). `stage` names the caller in an
+    /// out-of-memory error.
+    fn numeric_ldlt(
+        &self,
+        p: &Pattern,
+        vals: &[f64],
+        stage: &'static str,
+    ) -> Result<Option<Vec<f64>>, FeError> {
         let oom = |what: &str| FeError::Numerical {
-            stage: "LDLᵀ (Sturm check)",
+            stage,
             detail: format!("out of memory for the {what}"),
         };
         let mut l = Vec::new();
@@ -129,10 +144,7 @@ impl Symbolic {
             MemStack::new(&mut buf),
             Default::default(),
         );
-        if res.is_err() {
-            return Ok(None);
-        }
-        Ok(self.count_negative(&l))
+        Ok(res.is_ok().then_some(l))
     }
 
     /// Negative diagonal entries of D in the LDLᵀ values `l` (`None` on a zero or non-finite
@@ -181,30 +193,9 @@ impl Symbolic {
     /// Numeric LDLᵀ (no pivoting) of a symmetric, possibly indefinite matrix with lower values
     /// `vals`, kept for solves; `None` on a zero or non-finite pivot (a singular tangent).
     pub(crate) fn ldlt(&self, p: &Pattern, vals: &[f64]) -> Result<Option<Ldlt<'_>>, FeError> {
-        let oom = |what: &str| FeError::Numerical {
-            stage: "LDLᵀ (tangent)",
-            detail: format!("out of memory for the {what}"),
-        };
-        let mut l = Vec::new();
-        l.try_reserve_exact(self.chol.len_val())
-            .map_err(|_| oom("factor"))?;
-        l.resize(self.chol.len_val(), 0.0);
-        let req = self
-            .chol
-            .factorize_numeric_ldlt_scratch::<f64>(par(), Default::default());
-        let mut buf = MemBuffer::try_new(req).map_err(|_| oom("workspace"))?;
-        let res = self.chol.factorize_numeric_ldlt::<f64>(
-            &mut l,
-            Self::mat(p, vals),
-            Side::Lower,
-            Default::default(),
-            par(),
-            MemStack::new(&mut buf),
-            Default::default(),
-        );
-        if res.is_err() {
+        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (tangent)")? else {
             return Ok(None);
-        }
+        };
         Ok(self.count_negative(&l).map(|negative| Ldlt {
             sym: self,
             l,

@@ -60,7 +60,7 @@ impl<T: Clone> Source<T> {
             }
             Source::Path(rel) => {
                 let path = base.join(rel);
-                let text = read_text(&path).map_err(|source| ResolveError::Read {
+                let text = std::fs::read_to_string(&path).map_err(|source| ResolveError::Read {
                     path: path.clone(),
                     source,
                 })?;
@@ -71,12 +71,4 @@ impl<T: Clone> Source<T> {
             }
         }
     }
-}
-
-/// A text input file: read, and refused as such when it is not UTF-8.
-///
-/// # Errors
-/// What the file system says; invalid UTF-8 as [`std::io::ErrorKind::InvalidData`].
-pub fn read_text(path: &Path) -> std::io::Result<String> {
-    std::fs::read_to_string(path)
 }
