@@ -5,8 +5,6 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
-
 const KAPPE: &str = env!("CARGO_BIN_EXE_kappe");
 
 fn kappe(args: &[&str], cwd: &Path) -> Output {
@@ -273,7 +271,7 @@ fn shards_merged_equal_the_unsharded_study() {
         work,
     ));
     // Every file byte-identical but the manifest and the analysis wall-clock timings.
-    common::assert_same_outputs(&work.join("all"), &work.join("merged"));
+    crate::common::assert_same_outputs(&work.join("all"), &work.join("merged"));
 
     // A missing shard is an error naming the gap; --allow-incomplete merges what is there.
     let missing = kappe(

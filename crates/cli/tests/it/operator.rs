@@ -3,9 +3,6 @@
 //! cost guard (3), resume outputs kept (4), marked programs (5), `kappe schedule` (6), exit
 //! statuses and messages (8), wording (9). Defect 7 (Python) is in python/tests/test_operator.py.
 
-#[allow(dead_code)] // shared helpers; this file uses only some of them
-mod common;
-
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -292,7 +289,7 @@ fn a_new_design_run_keeps_the_resume_programs_of_the_previous_one() {
     let o = kappe(d, &["robot", "resume", "o", "--from-layer", &k.to_string()]);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let name = format!("resume_from_layer_{k}");
-    let before = common::tree(&d.join("o").join(&name));
+    let before = crate::common::tree(&d.join("o").join(&name));
     assert!(!before.is_empty());
     // Defect 4: the rerun replaced the output but moved the resume programs aside, with a word.
     let o = run();
@@ -301,7 +298,7 @@ fn a_new_design_run_keeps_the_resume_programs_of_the_previous_one() {
     assert!(err.contains(&name) && err.contains("aside"), "{err}");
     let kept = d.join("o.old-1").join(&name);
     assert_eq!(
-        common::tree(&kept),
+        crate::common::tree(&kept),
         before,
         "every file kept, byte for byte"
     );

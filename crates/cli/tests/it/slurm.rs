@@ -6,8 +6,6 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-mod common;
-
 const KAPPE: &str = env!("CARGO_BIN_EXE_kappe");
 
 const SLURM_VARS: [&str; 3] = [
@@ -78,7 +76,7 @@ fn the_slurm_array_task_takes_the_shard_of_its_index() {
         &[],
     );
     assert_eq!(rows(&work.join("env")), 2, "designs 1 and 3 of 0..5");
-    common::assert_same_outputs(&work.join("env"), &work.join("explicit"));
+    crate::common::assert_same_outputs(&work.join("env"), &work.join("explicit"));
     // `--array=0-1` without SLURM_ARRAY_TASK_MIN (0 is taken), and `--shard slurm`: task 0 is
     // shard 0/2.
     run(
@@ -93,7 +91,7 @@ fn the_slurm_array_task_takes_the_shard_of_its_index() {
         &[],
     );
     assert_eq!(rows(&work.join("env0")), 3, "designs 0, 2 and 4 of 0..5");
-    common::assert_same_outputs(&work.join("env0"), &work.join("explicit0"));
+    crate::common::assert_same_outputs(&work.join("env0"), &work.join("explicit0"));
 }
 
 /// What is wrong, the Slurm variables, and what the error must say.
