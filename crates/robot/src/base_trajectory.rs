@@ -32,7 +32,7 @@ pub struct BaseSample {
     /// Base position in the world (m).
     pub base_x: f64,
     pub base_y: f64,
-    /// Heading of the base x axis from world x (rad).
+    /// Heading of the base x axis from world x (rad, counter-clockwise, in (−π, π]).
     pub base_yaw: f64,
     /// Distance travelled along the bay axis since the plan's base pose at travel 0 (m).
     pub travel: f64,

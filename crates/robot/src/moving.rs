@@ -909,7 +909,9 @@ fn base_trajectory(
     base: &MovingBase,
     dir: DVec3,
 ) -> BaseTrajectory {
-    let yaw = base.yaw_deg.to_radians();
+    // Wrapped to (−π, π], the convention of every other base yaw Kappe writes (atan2 of the
+    // pose, e.g. trajectory.csv's `base_yaw`): one number for one heading in every file.
+    let yaw = crate::kinematics::wrap(base.yaw_deg.to_radians());
     let mut samples = Vec::new();
     let sample = |t: f64, s: f64| {
         let p = start.t + dir * s;

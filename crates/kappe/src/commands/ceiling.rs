@@ -60,6 +60,18 @@ pub enum BayEnds {
     StartSection,
 }
 
+impl BayEnds {
+    /// How the page and the terminal say it (the design file's words are `both_walls`, …).
+    #[must_use]
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::BothWalls => "two halves printed from both end walls",
+            Self::OneWall => "one cap leaning on the wall at y = 0",
+            Self::StartSection => "a start section on the bed",
+        }
+    }
+}
+
 /// The room.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -744,7 +756,7 @@ pub fn index_html(design: &CeilingDesign, summary: &Value) -> String {
         name = esc(design.name.as_str()),
         nb = s["bays"].as_array().map_or(0, Vec::len),
         len = design.ceiling.length,
-        ends = esc(&format!("{:?}", design.ceiling.ends)),
+        ends = design.ceiling.ends.describe(),
         verdict = if s["ok"].as_bool() == Some(true) {
             "pass"
         } else {

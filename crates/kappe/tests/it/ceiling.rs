@@ -61,6 +61,9 @@ fn three_bay_ceiling_end_to_end() {
     assert!((total - mass).abs() < 1e-9 * mass);
     let html = out.index_html();
     assert!(html.contains("bay_3/report.html") && html.contains("narrow"));
+    // The ends in words, not Rust's debug spelling of the enum (issue 28).
+    assert!(html.contains("ends: two halves printed from both end walls"));
+    assert!(!html.contains("BothWalls"));
     assert_eq!(s["ok"].as_bool().unwrap(), out.ok);
     // Every bay's own report renders.
     for b in &out.bays {

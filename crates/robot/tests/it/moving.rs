@@ -155,6 +155,16 @@ fn trajectory_csv_carries_the_base_pose_on_every_row() {
         let b = mp.trajectory.pose_at(r[3]);
         assert!((b.t.x - r[12]).abs() < 1e-9 && (b.t.y - r[13]).abs() < 1e-9);
     }
+    // One heading, one number: the yaw of base_trajectory.csv is the yaw of trajectory.csv
+    // (both in (−π, π]; the design's 270° once came out as 3π/2 in one file and −π/2 in the
+    // other). 1e-12 rad: the same angle through rot_z and atan2.
+    let yaw = mp.trajectory.samples[0].base_yaw;
+    assert!(yaw > -std::f64::consts::PI && yaw <= std::f64::consts::PI);
+    assert!(
+        rows.iter().all(|r| (r[14] - yaw).abs() < 1e-12),
+        "{yaw} vs {}",
+        rows[0][14]
+    );
 }
 
 #[test]
