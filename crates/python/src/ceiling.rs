@@ -15,7 +15,7 @@ use kappe::output::{OutputError, OutputFile};
 type PyFiles<'py> = Vec<(String, Bound<'py, PyBytes>)>;
 
 fn parse(text: &str) -> PyResult<CeilingDesign> {
-    CeilingDesign::from_toml_str(text).map_err(|e| crate::design_error(&e))
+    CeilingDesign::from_toml_str(text).map_err(|e| crate::errors::design_error(&e))
 }
 
 fn output_error(e: &OutputError) -> PyErr {
@@ -45,7 +45,7 @@ pub fn ceiling_bays(text: &str) -> PyResult<usize> {
     let ceiling = parse(text)?;
     Ok(ceiling
         .bay_designs()
-        .map_err(|e| crate::design_error(&e))?
+        .map_err(|e| crate::errors::design_error(&e))?
         .len())
 }
 
@@ -64,7 +64,7 @@ pub fn ceiling_run_bay<'py>(
     let ceiling = parse(text)?;
     let first = ceiling
         .bay_designs()
-        .map_err(|e| crate::design_error(&e))?
+        .map_err(|e| crate::errors::design_error(&e))?
         .into_iter()
         .next()
         .unwrap_or_default();
@@ -76,7 +76,7 @@ pub fn ceiling_run_bay<'py>(
         .detach(|| {
             kappe::commands::ceiling::run_bay(&ceiling, index, &options, &kappe::no_progress)
         })
-        .map_err(|e| crate::design_error(&e))?;
+        .map_err(|e| crate::errors::design_error(&e))?;
     let files = bay.files(allow_fail).map_err(|e| output_error(&e))?;
     Ok((
         bay.summary().to_string(),
