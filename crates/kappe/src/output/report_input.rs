@@ -34,8 +34,8 @@ use std::collections::HashMap;
 
 use kappe_report::{
     BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, Plot,
-    PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Station, Timeline,
-    WorstPlace,
+    PrintPath, PrintState, Quantity, QuantityPer, ReportInput, RobotAnimation, Series, Station,
+    Timeline, WorstPlace,
 };
 
 use crate::analysis::NetworkMode;
@@ -834,6 +834,41 @@ fn worst_places(cap: &Cap, input: &ReportInput) -> Vec<WorstPlace> {
     }
 }
 
+/// β of every state over the print, with the target β_min (issue 24: where in the print the
+/// chance of a collapse is largest). β rather than P_f on the axis: P_f = Φ(−β) spans many
+/// decades, and β is what the constraint `beta_min` bounds; the title says how to read P_f.
+fn reliability_plot(cap: &Cap, r: &crate::analysis::reliability::Reliability) -> Plot {
+    let progress = |i: usize| 100.0 * cap.states.get(i).map_or(0.0, |s| s.progress);
+    let beta: Vec<[f64; 2]> = r
+        .states
+        .iter()
+        .filter(|s| s.beta.is_finite())
+        .map(|s| [progress(s.index), s.beta])
+        .collect();
+    let target = match (beta.first(), beta.last()) {
+        (Some(a), Some(b)) => vec![[a[0], r.beta_min], [b[0], r.beta_min]],
+        _ => Vec::new(),
+    };
+    Plot {
+        title: format!(
+            "Reliability index β per state (P_f = Φ(−β); print β {:.2}, P_f {:.2e})",
+            r.beta, r.pf
+        ),
+        x_label: "print progress [%]".into(),
+        y_label: "β [-]".into(),
+        series: vec![
+            Series {
+                name: "β of the state".into(),
+                points: beta,
+            },
+            Series {
+                name: format!("β_min = {}", r.beta_min),
+                points: target,
+            },
+        ],
+    }
+}
+
 impl crate::Outcome {
     /// The input of the HTML report: the cap with the analysis, the robot plan, the schedule
     /// and the verdict's robot failures.
@@ -869,6 +904,9 @@ impl crate::Outcome {
                 }),
                 pass: r.ok(),
             });
+        }
+        if let Some(r) = &self.reliability {
+            extras.plots.push(reliability_plot(&self.cap, r));
         }
         extras.schedule = Some(crate::output::schedule_report::report_schedule(
             &self.cap,

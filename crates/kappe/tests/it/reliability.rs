@@ -175,6 +175,10 @@ fn reliability_only_with_the_table() {
         .iter()
         .find(|s| s.beta_by_check.contains_key("buckling"));
     assert!(last.is_some(), "no buckling check in {:?}", r.states);
+    // The report plots β over the print only when there is a reliability (issue 24).
+    let title = "Reliability index β per state";
+    assert!(out_u.report_html().unwrap().contains(title));
+    assert!(!out.report_html().unwrap().contains(title));
     // The deterministic results are the same run's.
     assert_eq!(
         out.analysis.as_ref().map(|a| a.constraints.clone()),
