@@ -32,6 +32,38 @@ pub fn parse_plan(text: &str, source: &str) -> Result<Plan, RobotError> {
         .map_err(|e| RobotError::invalid(source.to_string(), format!("not a kappe plan JSON: {e}")))
 }
 
+/// A plan file as `kappe design` writes it: stations (a fixed base per station) or one moving
+/// base ([`crate::moving::MovingPlan`], `[robot.base] mode = "moving"`).
+#[derive(Clone, Debug)]
+pub enum PlanFile {
+    /// A plan of stations.
+    Stations(Box<Plan>),
+    /// A plan whose base moves while the arm prints.
+    Moving(Box<crate::moving::MovingPlan>),
+}
+
+/// Parse a plan JSON of either kind: a moving plan is an object with `plan`, `travel` and
+/// `trajectory`; anything else is read as a plan of stations, so its errors are the ones
+/// [`parse_plan`] names. A moving plan's shape is validated ([`crate::moving::MovingPlan::validate_shape`]).
+pub fn parse_plan_file(text: &str, source: &str) -> Result<PlanFile, RobotError> {
+    let value: serde_json::Value = serde_json::from_str(text)
+        .map_err(|e| RobotError::invalid(source.to_string(), format!("not JSON: {e}")))?;
+    let moving = ["plan", "travel", "trajectory"]
+        .iter()
+        .all(|k| value.get(k).is_some());
+    if !moving {
+        return parse_plan(text, source).map(|p| PlanFile::Stations(Box::new(p)));
+    }
+    let mp: crate::moving::MovingPlan = serde_json::from_value(value).map_err(|e| {
+        RobotError::invalid(
+            source.to_string(),
+            format!("not a kappe moving-base plan JSON: {e}"),
+        )
+    })?;
+    mp.validate_shape()?;
+    Ok(PlanFile::Moving(Box::new(mp)))
+}
+
 /// Parse a print path CSV `layer,index,x,y,z,tx,ty,tz` (world frame; extra columns ignored)
 /// into layers in order of first appearance. A layer that appears again after another one, a
 /// wrong header, a short row or a field that is not a number is an error naming the line.

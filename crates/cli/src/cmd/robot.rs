@@ -96,14 +96,33 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         RobotCommand::Check { plan } => {
-            let p = files::parse_plan(&read(&plan)?, &plan.display().to_string())?;
-            let rep = check_plan(&p);
-            println!("{}", serde_json::to_string_pretty(&rep)?);
-            if rep.problems.is_empty() {
-                eprintln!("plan OK: {} waypoints verified", rep.waypoints);
+            let (json, waypoints, problems) =
+                match files::parse_plan_file(&read(&plan)?, &plan.display().to_string())? {
+                    files::PlanFile::Stations(p) => {
+                        let rep = check_plan(&p);
+                        (
+                            serde_json::to_string_pretty(&rep)?,
+                            rep.waypoints,
+                            rep.problems,
+                        )
+                    }
+                    // The moving base's own check: FK composed with the base trajectory,
+                    // clearance certified with the base moving, base speed and acceleration.
+                    files::PlanFile::Moving(mp) => {
+                        let rep = kappe_robot::moving::check_moving(&mp);
+                        (
+                            serde_json::to_string_pretty(&rep)?,
+                            rep.waypoints,
+                            rep.problems,
+                        )
+                    }
+                };
+            println!("{json}");
+            if problems.is_empty() {
+                eprintln!("plan OK: {waypoints} waypoints verified");
                 Ok(ExitCode::SUCCESS)
             } else {
-                eprintln!("plan FAILED: {} problem(s)", rep.problems.len());
+                eprintln!("plan FAILED: {} problem(s)", problems.len());
                 Ok(ExitCode::FAILURE)
             }
         }
@@ -179,16 +198,21 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
             allow_fail,
         } => {
             let plan_path = dir.join("plan.json");
-            let mut plan = files::parse_plan(&read(&plan_path)?, &plan_path.display().to_string())?;
+            let mut file =
+                files::parse_plan_file(&read(&plan_path)?, &plan_path.display().to_string())?;
+            let mark = match &mut file {
+                files::PlanFile::Stations(p) => &mut p.mark,
+                files::PlanFile::Moving(mp) => &mut mp.plan.mark,
+            };
             // A plan.json written before plans carried their mark: the summary beside it
             // still knows whether the design passed.
-            if plan.mark.failing_design.is_none() && summary_says_fails(&dir) {
-                plan.mark.failing_design = Some(format!(
+            if mark.failing_design.is_none() && summary_says_fails(&dir) {
+                mark.failing_design = Some(format!(
                     "{} says the design fails its checks",
                     dir.join("summary.json").display()
                 ));
             }
-            if let Some(why) = &plan.mark.failing_design {
+            if let Some(why) = &mark.failing_design {
                 if !allow_fail {
                     eprintln!(
                         "error: the design of {} fails its checks ({why}); no resume programs written. \
@@ -202,13 +226,41 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                     "warning: the design fails its checks ({why}); the programs are marked FAILING DESIGN"
                 );
             }
+            let out = out.unwrap_or_else(|| dir.join(format!("resume_from_layer_{from_layer}")));
+            let plan = match file {
+                files::PlanFile::Stations(p) => *p,
+                // A moving base resumes on the same base trajectory from the layer's travel
+                // (`resume_moving`: the arm's resume plan, the base re-timed, the moving check),
+                // written as `kappe design` writes a moving plan, with tracking programs.
+                files::PlanFile::Moving(mp) => {
+                    let resumed =
+                        kappe_robot::moving::resume_moving(&mp, from_layer).map_err(|e| {
+                            anyhow::Error::new(e)
+                                .context(format!("resuming {} failed", plan_path.display()))
+                        })?;
+                    let written = kappe::output::moving_plan_files(&resumed, "resume_part", true)?;
+                    let prepared = prepare_dir(&out, false, "robot resume")?;
+                    for f in &written {
+                        write_file_atomic(&prepared.path().join(&f.name), &f.bytes)?;
+                    }
+                    prepared.commit()?;
+                    println!(
+                        "resume from layer {from_layer} (moving base): {} waypoints, {} program(s), \
+                         {:.1} s → {}",
+                        resumed.plan.waypoint_count(),
+                        resumed.plan.parts.len(),
+                        resumed.plan.total_time,
+                        out.display()
+                    );
+                    return Ok(ExitCode::SUCCESS);
+                }
+            };
             let (resumed, programs) =
                 match files::resume_with_programs(&plan, from_layer, "resume_part") {
                     Err(e @ kappe_robot::RobotError::Verification(_)) => Err(anyhow::Error::new(e)
                         .context(format!("resuming {} failed its check", plan_path.display()))),
                     r => r.map_err(anyhow::Error::new),
                 }?;
-            let out = out.unwrap_or_else(|| dir.join(format!("resume_from_layer_{from_layer}")));
             let prepared = prepare_dir(&out, false, "robot resume")?;
             write_plan_outputs(prepared.path(), &resumed, &programs)?;
             prepared.commit()?;

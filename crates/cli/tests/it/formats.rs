@@ -143,4 +143,52 @@ fn moving_example_runs() {
             .unwrap()
             .ends_with("base_x,base_y,base_yaw")
     );
+    // The operator's tools read the moving plan too (issue 27): `robot check` runs the moving
+    // base's own check and passes; `robot resume` continues it from a layer with the base on
+    // its trajectory, and the resumed plan passes the same check and its programs the lint.
+    let ok = |o: &std::process::Output| {
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let o = kappe(tmp.path(), &["robot", "check", "o/plan.json"]);
+    ok(&o);
+    let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(rep["max_base_speed"].as_f64().unwrap() > 0.0, "{rep}");
+    let resume = [
+        "robot",
+        "resume",
+        "o",
+        "--from-layer",
+        "3",
+        "--out",
+        "r",
+        "--allow-fail",
+    ];
+    ok(&kappe(tmp.path(), &resume));
+    let r = tmp.path().join("r");
+    for f in [
+        "plan.json",
+        "base_trajectory.csv",
+        "trajectory.csv",
+        "programs.json",
+    ] {
+        assert!(r.join(f).is_file(), "{f} not written");
+    }
+    ok(&kappe(tmp.path(), &["robot", "check", "r/plan.json"]));
+    ok(&kappe(
+        tmp.path(),
+        &["robot", "lint", "r/resume_part01.script"],
+    ));
+    // The resumed trajectory starts at layer 3: fewer rows than the whole print's.
+    let rows = |p: &str| {
+        std::fs::read_to_string(tmp.path().join(p))
+            .unwrap()
+            .lines()
+            .count()
+    };
+    assert!(rows("r/trajectory.csv") < rows("o/trajectory.csv"));
 }

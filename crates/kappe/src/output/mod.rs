@@ -17,7 +17,7 @@ pub mod summary;
 pub use dir::{
     MANIFEST, PreparedDir, check_user_file, prepare_dir, write_file_atomic, write_user_file,
 };
-pub use files::{OutputFile, plan_files};
+pub use files::{OutputFile, moving_plan_files, plan_files};
 
 /// Why an output could not be written.
 #[derive(Debug, thiserror::Error)]
