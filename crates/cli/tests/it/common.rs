@@ -2,6 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
 
 /// Every file under `dir`, relative path → bytes.
 pub fn tree(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
@@ -55,4 +56,18 @@ pub fn assert_same_outputs(a: &Path, b: &Path) {
             assert!(b[path] == *bytes, "{} differs", path.display());
         }
     }
+}
+
+/// Runs the `kappe` binary in `dir` with `args`.
+pub fn kappe(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_kappe"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A process's output bytes as text.
+pub fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
 }

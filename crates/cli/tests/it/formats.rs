@@ -1,16 +1,9 @@
 //! Issue 16: every input format has a page in `docs/formats/` holding the complete example that
 //! `kappe init --kind K` writes, verbatim, and that example runs as it is.
 
+use crate::common::kappe;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn kappe(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kappe"))
-        .current_dir(cwd)
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::process::Output;
 
 fn init(cwd: &Path, kind: &str) -> String {
     let file = format!("{kind}.toml");

@@ -3,20 +3,9 @@
 //! cost guard (3), resume outputs kept (4), marked programs (5), `kappe schedule` (6), exit
 //! statuses and messages (8), wording (9). Defect 7 (Python) is in python/tests/test_operator.py.
 
+use crate::common::{kappe, text};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn kappe(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kappe"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+use std::process::Command;
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()

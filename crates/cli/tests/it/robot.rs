@@ -2,23 +2,11 @@
 //! codes (0 ok, 1 fails its check, 2 bad input) and nothing written on bad input.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
+use crate::common::{kappe, text};
 use kappe_robot::frames::Iso;
 use kappe_robot::setup::{BasePlacement, RobotSetup};
 use kappe_robot::synthetic::cap_path;
-
-fn kappe(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_kappe"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
 
 /// 4 layers of 12 points of the synthetic cap and a config with the base fixed in front of it
 /// (as the robot crate's own tests), ≤ 30 targets per program (so two files).
