@@ -32,7 +32,7 @@ enum Command {
     Robot(cmd::robot::RobotCommand),
     /// Design a cap ceiling: form-find every print state, analyse, write outputs.
     Design(cmd::design::DesignArgs),
-    /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability|ceiling.
+    /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability|ceiling|moving|corrugated.
     Init(cmd::init::InitArgs),
     /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
     Study(cmd::study::StudyCommand),
@@ -44,6 +44,8 @@ enum Command {
     Buildability(cmd::buildability::BuildabilityArgs),
     /// The design loop: vary the free parameters within bounds to meet every constraint with the least material.
     Optimize(cmd::optimize::OptimizeArgs),
+    /// Corrugated caps: the governing buckling factor per kg and per print minute over a grid of wave amplitudes and wavelengths, against the smooth cap.
+    Corrugation(cmd::corrugation::CorrugationArgs),
 }
 
 /// The exit-status scheme, shown by `kappe --help` (see `exit.rs`).
@@ -65,6 +67,7 @@ fn main() -> ExitCode {
         Command::Optimize(a) => cmd::optimize::run(a),
         Command::Buildability(a) => cmd::buildability::run(a),
         Command::Schedule(a) => cmd::schedule::run(a),
+        Command::Corrugation(a) => cmd::corrugation::run(a),
     };
     match result {
         Ok(code) => code,

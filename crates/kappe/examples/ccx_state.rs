@@ -6,6 +6,7 @@
 //! ANDES+DKMT on the same mesh.
 //!
 //! `cargo run --release -p kappe --example ccx_state -- STATE [STATE …]`
+//! (`KAPPE_DESIGN=file.toml` checks that design instead of the default, e.g. a corrugated cap).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -66,7 +67,10 @@ fn ccx_run(
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let design = kappe::Design::default();
+    let design = match std::env::var_os("KAPPE_DESIGN") {
+        Some(path) => kappe::Design::from_toml_str(&std::fs::read_to_string(path)?)?,
+        None => kappe::Design::default(),
+    };
     let cap = kappe::design_cap(&design, &|_| {})?;
     let options = AnalysisOptions::default();
     let dir = Path::new("target/ccx_state");

@@ -14,7 +14,7 @@ use crate::output::write_user_file;
 pub struct InitArgs {
     /// Where to write the example (default: `kappe.toml`, or `<kind>.toml` for other kinds).
     pub path: Option<PathBuf>,
-    /// Which example: design, study, prototypes, optimize, buildability, ceiling, moving.
+    /// Which example: design, study, prototypes, optimize, buildability, ceiling, moving, corrugated.
     #[arg(long, default_value = "design")]
     pub kind: String,
     /// Overwrite an existing file.

@@ -3,6 +3,7 @@
 pub mod buildability;
 pub mod calibrate;
 pub mod cem;
+pub mod corrugation;
 pub mod design;
 pub mod fe;
 pub mod init;

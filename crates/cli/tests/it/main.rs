@@ -3,6 +3,7 @@
 
 mod ceiling;
 mod common;
+mod corrugation;
 mod design;
 mod fe;
 mod formats;

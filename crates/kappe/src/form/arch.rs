@@ -195,10 +195,30 @@ pub fn layer_topology(
 /// two parameters, the crown force and one length shared by every trail edge (both kept in
 /// compression), and two point goals, the feet.
 pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
+    form_find(spec, None)
+}
+
+/// [`form_find_layer`] with a prescribed segment count `2·nt + 1` (`nt` = `(segments − 1) / 2`)
+/// instead of the one Δs gives: the layers of a corrugated centre section (`crate::form::section`)
+/// share the columns of layer 0, so every layer needs layer 0's node count whatever its rise.
+pub fn form_find_layer_with_segments(
+    spec: &ArchSpec,
+    segments: usize,
+) -> Result<Arch, DesignError> {
+    if segments < 5 || segments % 2 == 0 {
+        return Err(DesignError::FormFinding(format!(
+            "{segments} segments requested; allowed: an odd count ≥ 5"
+        )));
+    }
+    form_find(spec, Some((segments - 1) / 2))
+}
+
+fn form_find(spec: &ArchSpec, fixed_nt: Option<usize>) -> Result<Arch, DesignError> {
     let cat = Catenary::new(spec.span, spec.rise, spec.tilt, spec.specific_weight);
     let arc = cat.arc_length(spec.span);
     // 2·nt + 1 = round(arc / Δs), rounded to an odd count of at least 5 segments.
-    let mut nt = (((arc / spec.path_sampling) - 1.0) / 2.0).round().max(2.0) as usize;
+    let mut nt = fixed_nt
+        .unwrap_or_else(|| (((arc / spec.path_sampling) - 1.0) / 2.0).round().max(2.0) as usize);
     let gamma_a = spec.specific_weight * spec.layer_width * spec.layer_height;
     let mut s = arc / (2 * nt + 1) as f64;
     let mut mu = -gamma_a * cat.a / spec.tilt.cos();
@@ -218,6 +238,9 @@ pub fn form_find_layer(spec: &ArchSpec) -> Result<Arch, DesignError> {
             if (s - s_load).abs() <= 1e-15 * s.max(1.0) && it > 0 {
                 break;
             }
+        }
+        if fixed_nt.is_some() {
+            break;
         }
         // Check the segment count against Δs; rebuild once if the rounding changed.
         let arc_now = (2 * nt + 1) as f64 * s;

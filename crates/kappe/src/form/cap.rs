@@ -5,13 +5,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer};
+use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer, form_find_layer_with_segments};
 use crate::form::beads::{TriMesh, bead_mesh};
 use crate::form::forces::{Sections2D, StateForces, state_forces};
 use crate::form::frame::LayerFrame;
-use crate::form::overhang::layer_overhangs;
+use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
-use crate::form::section::{Sections, build_sections_with_end};
+use crate::form::section::{Sections, build_corrugated_sections, build_sections_with_end};
 use crate::form::states::{State, build_state};
 use crate::input::design::Design;
 use crate::input::error::DesignError;
@@ -46,6 +46,9 @@ pub struct Cap {
     pub frame: LayerFrame,
     /// Layer 0.
     pub arch: Arch,
+    /// The arch of every centre layer of a corrugated cap (`[cap.corrugation]`), layer 0 first;
+    /// empty for the prismatic cap, whose centre layers are all translates of [`Cap::arch`].
+    pub centre_arches: Vec<Arch>,
     /// The catenary limit of layer 0 (closed form).
     pub catenary: Catenary,
     /// All layers in print order.
@@ -69,16 +72,71 @@ pub struct Cap {
 impl Cap {
     /// Cross-section areas for stresses.
     pub fn areas(&self) -> Sections2D {
-        areas(&self.design, &self.arch)
+        areas(&self.design, &self.arch, &self.centre_arches)
     }
 }
 
-fn areas(design: &Design, arch: &Arch) -> Sections2D {
+/// The bed-joint area takes the shortest segment of any layer (a corrugated cap's layers have
+/// their own segment lengths; the shortest gives the largest bed-joint stress).
+fn areas(design: &Design, arch: &Arch, centre: &[Arch]) -> Sections2D {
     let lw = design.print.layer_width;
+    let s = centre
+        .iter()
+        .map(|a| a.segment_length)
+        .fold(arch.segment_length, f64::min);
     Sections2D {
         along_layer: lw * design.print.layer_height,
-        bed_joint: lw * arch.segment_length,
+        bed_joint: lw * s,
     }
+}
+
+/// Form-find every centre layer of a corrugated cap in its own plane to its own rise
+/// (`CorrugationSpec::layer_rise`), with layer 0's segment count so the columns run through.
+/// Layer 0 is `arch` itself. An arch that cannot be found, or that is not in compression
+/// everywhere, is an error naming the layer and its rise.
+fn corrugated_arches(
+    design: &Design,
+    spec: &ArchSpec,
+    arch: &Arch,
+    n_centre: usize,
+) -> Result<Vec<Arch>, DesignError> {
+    let Some(w) = design.corrugation() else {
+        return Ok(Vec::new());
+    };
+    let step = design.print.layer_height / spec.tilt.cos();
+    let segments = arch.segments();
+    (0..n_centre)
+        .into_par_iter()
+        .map(|k| {
+            if k == 0 {
+                return Ok(arch.clone());
+            }
+            let rise = w.layer_rise(spec.rise, step, k);
+            let layer_spec = ArchSpec { rise, ..*spec };
+            let a = form_find_layer_with_segments(&layer_spec, segments).map_err(|e| {
+                DesignError::FormFinding(format!(
+                    "corrugated centre layer {k} (rise {:.1} mm from amplitude {} m, wavelength \
+                     {} m): {e}",
+                    rise * 1e3,
+                    w.amplitude,
+                    w.wavelength
+                ))
+            })?;
+            if let Some((i, f)) = a
+                .segment_forces
+                .iter()
+                .enumerate()
+                .find(|(_, f)| !(**f < 0.0))
+            {
+                return Err(DesignError::FormFinding(format!(
+                    "corrugated centre layer {k} (rise {:.1} mm): segment {i} carries {f:.3e} N, \
+                     not compression; lower cap.corrugation.amplitude",
+                    rise * 1e3
+                )));
+            }
+            Ok(a)
+        })
+        .collect()
 }
 
 /// Form-find the layer, build the sections and states, and solve the forces of every state.
@@ -110,18 +168,43 @@ pub(crate) fn design_cap_until(
     let catenary = Catenary::new(spec.span, spec.rise, tilt, spec.specific_weight);
     let bead_weight_per_m =
         design.material.specific_weight * design.print.layer_width * design.print.layer_height;
-    let sections = build_sections_with_end(
-        &arch,
-        &frame,
-        design.cap.length,
-        design.print.layer_height,
-        design.print.start_arch_fraction,
-        |chord| 0.5 * chord * bead_weight_per_m,
-        design.cap.end,
-    )?;
-    let overhangs = layer_overhangs(&sections, &frame);
+    let (sections, centre_arches) = if design.corrugation().is_some() {
+        let n_centre = crate::form::section::centre_layer_count(
+            design.cap.length,
+            &frame,
+            design.print.layer_height,
+        );
+        let centre = corrugated_arches(design, &spec, &arch, n_centre)?;
+        let sections = build_corrugated_sections(
+            &arch,
+            &centre,
+            &frame,
+            design.cap.length,
+            design.print.layer_height,
+            design.print.start_arch_fraction,
+            |chord| 0.5 * chord * bead_weight_per_m,
+            design.cap.end,
+        )?;
+        (sections, centre)
+    } else {
+        let sections = build_sections_with_end(
+            &arch,
+            &frame,
+            design.cap.length,
+            design.print.layer_height,
+            design.print.start_arch_fraction,
+            |chord| 0.5 * chord * bead_weight_per_m,
+            design.cap.end,
+        )?;
+        (sections, Vec::new())
+    };
+    let overhangs = if centre_arches.is_empty() {
+        layer_overhangs(&sections, &frame)
+    } else {
+        measured_overhangs(&sections, &frame)
+    };
     let phi = design.print.start_arch_fraction;
-    let area = areas(design, &arch);
+    let area = areas(design, &arch, &centre_arches);
     let total = sections.layers.len();
     let solve = |top: usize| {
         if stop.load(Ordering::Relaxed) {
@@ -166,6 +249,7 @@ pub(crate) fn design_cap_until(
         design: design.clone(),
         frame,
         arch,
+        centre_arches,
         catenary,
         sections,
         overhangs,

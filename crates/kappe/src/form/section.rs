@@ -108,6 +108,11 @@ pub fn build_sections(
     )
 }
 
+/// N = round(Cl·cos(am) / lh), at least 1.
+pub fn centre_layer_count(length: f64, frame: &LayerFrame, layer_height: f64) -> usize {
+    ((length * frame.tilt.cos() / layer_height).round() as usize).max(1)
+}
+
 /// Build the sections for the given end: the start section of method.md §6, or none against an
 /// end wall.
 pub fn build_sections_with_end(
@@ -119,7 +124,7 @@ pub fn build_sections_with_end(
     half_chord_weight: impl Fn(f64) -> f64,
     end: EndKind,
 ) -> Result<Sections, DesignError> {
-    let n_centre = ((length * frame.tilt.cos() / layer_height).round() as usize).max(1);
+    let n_centre = centre_layer_count(length, frame, layer_height);
     if end == EndKind::EndWall {
         return Ok(Sections {
             n_centre,
@@ -184,6 +189,58 @@ pub fn build_sections_with_end(
         end,
         layers,
     })
+}
+
+/// The sections of a corrugated cap (`[cap.corrugation]`, docs/corrugation.md): those of
+/// [`build_sections_with_end`], then centre layer k takes its own form-found arch `centre[k]`
+/// (in the plane of layer k: its points translated by `k·(lh / cos am)·e_y`). Layer 0's arch is
+/// `arch` itself (the wave is zero there), so the start section and an end wall are unchanged.
+#[allow(clippy::too_many_arguments)]
+pub fn build_corrugated_sections(
+    arch: &Arch,
+    centre: &[Arch],
+    frame: &LayerFrame,
+    length: f64,
+    layer_height: f64,
+    phi: f64,
+    half_chord_weight: impl Fn(f64) -> f64,
+    end: EndKind,
+) -> Result<Sections, DesignError> {
+    let mut sections = build_sections_with_end(
+        arch,
+        frame,
+        length,
+        layer_height,
+        phi,
+        half_chord_weight,
+        end,
+    )?;
+    if centre.len() != sections.n_centre {
+        return Err(DesignError::FormFinding(format!(
+            "{} corrugated centre arches for {} centre layers",
+            centre.len(),
+            sections.n_centre
+        )));
+    }
+    let first = sections.n_start;
+    for (k, a) in centre.iter().enumerate() {
+        if a.points.len() != arch.points.len() {
+            return Err(DesignError::FormFinding(format!(
+                "corrugated centre layer {k} has {} nodes, layer 0 has {}: the columns must \
+                 run through every layer",
+                a.points.len(),
+                arch.points.len()
+            )));
+        }
+        let layer = &mut sections.layers[first + k];
+        let offset = layer.offset;
+        for ((node, p), w) in layer.nodes.iter_mut().zip(&a.points).zip(&a.weights) {
+            node.xyz = p + offset;
+            node.weight = *w;
+        }
+        layer.segment_forces.clone_from(&a.segment_forces);
+    }
+    Ok(sections)
 }
 
 /// Centre layers 0..N−1: layer 0 translated by `k·(lh / cos am)·e_y`.

@@ -49,6 +49,70 @@ pub struct CapSpec {
     /// `"end_wall"` (an end wall takes the stack thrust; `kappe::form::ends`).
     #[serde(skip_serializing_if = "EndKind::is_default")]
     pub end: EndKind,
+    /// `[cap.corrugation]`: a wave of the centre layers' rise along the cap (issue 26,
+    /// `docs/corrugation.md`). Absent or `amplitude = 0`: the prismatic centre section.
+    /// Not written back when absent or of amplitude 0, so that a cap with `amplitude = 0` is the
+    /// prismatic cap byte for byte, down to the design echoed in `summary.json`.
+    #[serde(default, skip_serializing_if = "no_corrugation")]
+    pub corrugation: Option<CorrugationSpec>,
+}
+
+fn no_corrugation(c: &Option<CorrugationSpec>) -> bool {
+    c.as_ref().is_none_or(|c| c.amplitude == 0.0)
+}
+
+/// How the corrugation varies across the span.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CorrugationShape {
+    /// Each centre layer is form-found to its own rise `Cr + a·sin(2π·y/λ)`: the wave is zero
+    /// at the beams (the feet stay on the springing lines) and largest at the crown.
+    #[default]
+    Crown,
+}
+
+/// `[cap.corrugation]`: the centre section undulates along the cap (docs/corrugation.md).
+///
+/// Centre layer k (its plane crossing the base at `y_k = k·lh/cos(am)`) is form-found with CEM
+/// in its tilted plane to the rise `Cr_k = Cr + a·sin(2π·y_k/λ)`; layer 0 keeps `Cr`, so the
+/// start section (translates of layer 0) and an end wall meet the wave where it is zero.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CorrugationSpec {
+    /// a: crown amplitude of the wave, m (0: no corrugation).
+    pub amplitude: f64,
+    /// λ: wavelength along the cap (y, on the base plane), m.
+    pub wavelength: f64,
+    /// How the wave varies across the span (`"crown"`).
+    pub shape: CorrugationShape,
+}
+
+impl Default for CorrugationSpec {
+    fn default() -> Self {
+        CorrugationSpec {
+            amplitude: 0.0,
+            wavelength: 0.3,
+            shape: CorrugationShape::Crown,
+        }
+    }
+}
+
+/// A wavelength must span at least this many layer steps: a sine sampled at 8 points per
+/// period keeps every peak within 1 − cos(π/8) ≈ 8 % of the amplitude, and successive layers
+/// then differ by at most `a·2π/8` in rise, so the wave is printed, not aliased.
+pub const MIN_LAYERS_PER_WAVELENGTH: f64 = 8.0;
+
+impl CorrugationSpec {
+    /// The rise target of centre layer `k` for the cap rise `rise` and layer step `step`
+    /// (`lh/cos(am)`), m.
+    pub fn layer_rise(&self, rise: f64, step: f64, k: usize) -> f64 {
+        match self.shape {
+            CorrugationShape::Crown => {
+                rise + self.amplitude
+                    * (2.0 * std::f64::consts::PI * step * k as f64 / self.wavelength).sin()
+            }
+        }
+    }
 }
 
 /// Material (method.md §2–3).
@@ -142,6 +206,53 @@ fn is_stations(m: &kappe_robot::BaseMode) -> bool {
 }
 
 /// Check the moving-base settings of `[robot.base]`, each error naming its field.
+/// `[cap.corrugation]` against the cap: the wave must leave every layer a cap arch of this
+/// method (0.05 ≤ rise/span ≤ 1, as `cap.rise`) and be resolved by the layers.
+fn validate_corrugation(w: &CorrugationSpec, c: &CapSpec, step: f64) -> Result<(), DesignError> {
+    let a = w.amplitude;
+    if !(a.is_finite() && a >= 0.0) {
+        return Err(DesignError::Invalid {
+            field: "cap.corrugation.amplitude",
+            value: format!("{a}"),
+            allowed: "allowed: a finite amplitude ≥ 0 m".into(),
+        });
+    }
+    let lambda = w.wavelength;
+    let min_lambda = MIN_LAYERS_PER_WAVELENGTH * step;
+    if !(lambda.is_finite() && lambda >= min_lambda) {
+        return Err(DesignError::Invalid {
+            field: "cap.corrugation.wavelength",
+            value: format!("{lambda}"),
+            allowed: format!(
+                "allowed: wavelength ≥ {MIN_LAYERS_PER_WAVELENGTH} layer steps = {:.1} mm \
+                 (layer step lh/cos(am) = {:.2} mm); a shorter wave is not resolved by the layers",
+                min_lambda * 1e3,
+                step * 1e3
+            ),
+        });
+    }
+    if a == 0.0 {
+        return Ok(());
+    }
+    let (lo, hi) = (c.rise - a, c.rise + a);
+    if lo < 0.05 * c.span || hi > c.span {
+        return Err(DesignError::Invalid {
+            field: "cap.corrugation.amplitude",
+            value: format!("{a}"),
+            allowed: format!(
+                "the layers' rises run from {:.1} mm to {:.1} mm; allowed: every layer's \
+                 rise/span in [0.05, 1] (rise − amplitude ≥ {:.1} mm and rise + amplitude ≤ span \
+                 = {:.1} mm), as for cap.rise",
+                lo * 1e3,
+                hi * 1e3,
+                0.05 * c.span * 1e3,
+                c.span * 1e3
+            ),
+        });
+    }
+    Ok(())
+}
+
 fn validate_moving(m: &kappe_robot::MovingBase) -> Result<(), DesignError> {
     let check = |field: &'static str, value: f64, ok: bool, allowed: &str| {
         if value.is_finite() && ok {
@@ -326,6 +437,7 @@ impl Default for CapSpec {
             length: 0.6,
             tilt_deg: 25.0,
             end: EndKind::StartSection,
+            corrugation: None,
         }
     }
 }
@@ -423,6 +535,12 @@ impl Design {
             }),
             (None, None) => Ok(TimeModel::constant(self.material.youngs_modulus)),
         }
+    }
+
+    /// The corrugation of the centre section, if its amplitude is not zero (amplitude 0 is the
+    /// prismatic cap on exactly its own code path).
+    pub fn corrugation(&self) -> Option<&CorrugationSpec> {
+        self.cap.corrugation.as_ref().filter(|c| c.amplitude != 0.0)
     }
 
     /// l_o,max, defaulting to lw/2 (method.md §3).
@@ -564,6 +682,9 @@ impl Design {
                 "gives {n_layers:.1} centre layers; allowed 1 to 5000 (length·cos(tilt)/layer height)"
             ),
         )?;
+        if let Some(w) = &c.corrugation {
+            validate_corrugation(w, c, p.layer_height / self.tilt().cos())?;
+        }
         check(
             "constraints.sigma_min",
             k.sigma_min,
