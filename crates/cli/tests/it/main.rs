@@ -2,6 +2,7 @@
 //! `cargo test`), a module per topic. Each module runs the `kappe` binary end to end.
 
 mod ceiling;
+mod collapse;
 mod common;
 mod corrugation;
 mod design;

@@ -60,6 +60,13 @@ pub struct StateAnalysis {
     /// Age of the oldest printed layer at this state, s (only with a time model).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bottom_age_s: Option<f64>,
+    /// Collapse factor of the imperfect state (`[analysis.nonlinear]`; only the states the
+    /// state rule ran, docs/collapse.md §3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collapse_factor: Option<f64>,
+    /// What ends its path there: `limit_point` or the material check that failed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collapse_mode: Option<crate::analysis::collapse::CollapseMode>,
     /// Mode 1 per shell node (network node index, translation), for the report's 3D view;
     /// empty when not analysed. Not in `summary.json`.
     #[serde(skip)]
@@ -191,6 +198,11 @@ pub fn levers(name: &str) -> &'static str {
              waits)"
         }
         "overhang_max" => "the layers overhang too far: lower cap.tilt_deg or print.layer_height",
+        "collapse_min" => {
+            "the imperfect state collapses (docs/collapse.md): raise cap.rise, widen the layers \
+             (print.layer_width), wait between layers so they stiffen and strengthen (`kappe \
+             schedule`), or measure your placement tolerance and imperfection"
+        }
         _ => "see the report (report.html) for the governing state",
     }
 }
@@ -527,9 +539,68 @@ pub(crate) fn analyze_scheduled(
             mechanism,
             shell_nodes: nodes,
             fe_seconds: p.fe_seconds,
+            collapse_factor: None,
+            collapse_mode: None,
             mode: p.mode.clone(),
         });
     }
+
+    // The collapse check (docs/collapse.md): the states the state rule picks from the linear
+    // bounds just found.
+    let nonlinear = options
+        .nonlinear
+        .unwrap_or(crate::input::nonlinear::NonlinearSpec {
+            // Opt-in for caps: a cap state's path costs ~100 of its LBA solves (docs/collapse.md §6).
+            enabled: false,
+            ..Default::default()
+        });
+    let collapse_min = design.constraints.collapse_min();
+    let mut w_collapse: Option<Worst> = None;
+    let mut collapse_checked = 0;
+    let t_collapse = Instant::now();
+    if options.buckling && nonlinear.enabled {
+        let bounds: Vec<crate::analysis::collapse::LinearBound> = states
+            .iter()
+            .filter_map(|s| {
+                let b = s.blf.filter(|b| *b > 0.0)?;
+                let inv =
+                    |u: Option<f64>| u.filter(|u| *u > 0.0).map_or(f64::INFINITY, |u| 1.0 / u);
+                Some(crate::analysis::collapse::LinearBound {
+                    state: s.index,
+                    bound: b
+                        .min(inv(s.strength_utilisation))
+                        .min(inv(s.sliding_utilisation)),
+                })
+            })
+            .collect();
+        let found = crate::analysis::collapse::cap_states_to_run(&bounds, false, &|top| {
+            cancelled()?;
+            crate::analysis::collapse::cap_state_collapse(
+                cap,
+                options,
+                &nonlinear,
+                green.as_ref(),
+                top,
+            )
+        })?;
+        for (q, c) in found {
+            if let Some(s) = states.get_mut(q) {
+                collapse_checked += 1;
+                s.collapse_factor = Some(c.factor);
+                s.collapse_mode = Some(c.mode);
+                s.ok &= c.factor >= collapse_min;
+                keep_min(&mut w_collapse, c.factor, q, || {
+                    format!(
+                        "{} (LBA {:.3}, w0 = {:.2} mm)",
+                        c.mode.name(),
+                        c.lba,
+                        c.w0 * 1e3
+                    )
+                });
+            }
+        }
+    }
+    let wall_collapse = t_collapse.elapsed().as_secs_f64();
 
     let result = |name: &'static str,
                   description: &'static str,
@@ -589,6 +660,17 @@ pub(crate) fn analyze_scheduled(
             &|v| v <= lo_max,
         ),
     ];
+    if collapse_checked > 0 {
+        constraints.push(result(
+            "collapse_min",
+            "collapse: factor of the imperfect state's nonlinear path (limit point or the aged material at the faces) ≥ collapse_min",
+            "1",
+            collapse_min,
+            w_collapse,
+            collapse_checked,
+            &|v| v >= collapse_min,
+        ));
+    }
     if green.as_ref().is_some_and(|g| g.time.strength.is_some()) {
         constraints.push(result(
             "strength",
@@ -618,7 +700,7 @@ pub(crate) fn analyze_scheduled(
         timings: Timings {
             stresses: wall_stresses,
             stresses_sum: t_stress,
-            fe: wall_fe,
+            fe: wall_fe + wall_collapse,
             fe_sum: t_fe,
             total: t_all.elapsed().as_secs_f64(),
         },

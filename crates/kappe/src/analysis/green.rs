@@ -79,6 +79,9 @@ pub enum FailureMode {
     Strength,
     /// Bed-joint sliding: |τ| > c + σ_n·tan φ.
     Sliding,
+    /// Nonlinear collapse of the imperfect state below `collapse_min` (limit point or the
+    /// material along the path; `crate::analysis::collapse`).
+    Collapse,
 }
 
 impl FailureMode {
@@ -88,6 +91,7 @@ impl FailureMode {
             FailureMode::Buckling => "buckling",
             FailureMode::Strength => "strength",
             FailureMode::Sliding => "sliding",
+            FailureMode::Collapse => "collapse",
         }
     }
 }
@@ -496,7 +500,15 @@ impl CapGreen {
         st: &kappe_fe::StaticResult,
         top: usize,
     ) -> StressWorst {
-        let elements: Vec<ElementLayers> = shell
+        let elements = self.element_layers(shell);
+        let ages = self.schedule.ages(top + 1);
+        stress_checks(st, &elements, &ages, &self.time, &GreenOptions::default())
+    }
+
+    /// The print indices of the layers of every element of a state's shell (by layer id) and
+    /// the cap's bed normal: what the strength and sliding checks need per element.
+    pub fn element_layers(&self, shell: &crate::analysis::shell::StateShell) -> Vec<ElementLayers> {
+        shell
             .element_layers
             .iter()
             .map(|(a, b)| {
@@ -508,8 +520,6 @@ impl CapGreen {
                     bed_normal: self.bed_normal,
                 }
             })
-            .collect();
-        let ages = self.schedule.ages(top + 1);
-        stress_checks(st, &elements, &ages, &self.time, &GreenOptions::default())
+            .collect()
     }
 }

@@ -22,12 +22,14 @@ use serde::{Deserialize, Serialize};
 
 use kappe_fe::{Material, ShellModel, Support};
 
+use crate::analysis::collapse::{Collapse, CollapseMode, CollapseOptions, collapse_factor};
 use crate::analysis::green::{
     BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement,
     check_state_warm,
 };
 use crate::input::error::DesignError;
 use crate::input::material::{TimeModel, TimeModelSpec};
+use crate::input::nonlinear::{BaseRestraint, NonlinearSpec};
 use crate::schedule::{Schedule, ScheduleSpec};
 
 /// The test object.
@@ -110,6 +112,8 @@ pub struct ChecksSpec {
     pub sliding: bool,
     /// Stop at the first failing layer count (false: check up to `max_layers`).
     pub stop_at_failure: bool,
+    /// Smallest admissible collapse factor (with `[analysis.nonlinear]`; docs/collapse.md).
+    pub collapse_min: f64,
 }
 
 impl Default for ChecksSpec {
@@ -120,6 +124,7 @@ impl Default for ChecksSpec {
             strength: true,
             sliding: true,
             stop_at_failure: true,
+            collapse_min: 1.0,
         }
     }
 }
@@ -141,6 +146,36 @@ pub struct BuildabilitySpec {
     /// Checks.
     #[serde(default)]
     pub checks: ChecksSpec,
+    /// `[analysis]`: the nonlinear collapse check (`[analysis.nonlinear]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub analysis: Option<BuildAnalysis>,
+}
+
+/// `[analysis]` of a buildability spec.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BuildAnalysis {
+    /// The collapse check of every layer count (docs/collapse.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nonlinear: Option<NonlinearSpec>,
+}
+
+impl BuildabilitySpec {
+    /// The collapse check's options, if `[analysis.nonlinear]` is given and enabled.
+    pub fn nonlinear(&self) -> Option<&NonlinearSpec> {
+        self.analysis
+            .as_ref()
+            .and_then(|a| a.nonlinear.as_ref())
+            .filter(|n| n.enabled)
+    }
+
+    /// How the first layer is held (clamped unless `[analysis.nonlinear] base` says otherwise).
+    pub fn base(&self) -> BaseRestraint {
+        self.analysis
+            .as_ref()
+            .and_then(|a| a.nonlinear.as_ref())
+            .map_or(BaseRestraint::Clamped, |n| n.base)
+    }
 }
 
 /// The commented example `kappe init --kind buildability` writes: the Wolfs 2018 cylinder.
@@ -271,6 +306,18 @@ impl BuildabilitySpec {
             ));
         }
         pos("checks.blf_min", c.blf_min)?;
+        pos("checks.collapse_min", c.collapse_min)?;
+        if let Some(n) = self.analysis.as_ref().and_then(|a| a.nonlinear.as_ref()) {
+            n.validate()?;
+            if n.enabled && !c.buckling {
+                return Err(bad(
+                    "checks.buckling",
+                    false,
+                    "true with [analysis.nonlinear] (its imperfection is the lowest buckling \
+                     mode); or set [analysis.nonlinear] enabled = false",
+                ));
+            }
+        }
         let p = &self.process;
         let layer_time = match (p.layer_time, p.print_speed) {
             (Some(_), Some(_)) => {
@@ -381,7 +428,10 @@ pub fn object_shell(r: &Resolved, n: usize) -> (ShellModel, Vec<ElementLayers>) 
             unit_weight: m.specific_weight,
         },
     );
-    model.supports = (0..cols).map(Support::clamped).collect();
+    model.supports = match r.spec.base() {
+        BaseRestraint::Clamped => (0..cols).map(Support::clamped).collect(),
+        BaseRestraint::Pinned => (0..cols).map(Support::pinned).collect(),
+    };
     (model, layers)
 }
 
@@ -412,6 +462,13 @@ pub struct BuildState {
     pub governing: Option<FailureMode>,
     /// The failing check, if any.
     pub failure: Option<FailureMode>,
+    /// Collapse factor of the imperfect state (with `[analysis.nonlinear]`).
+    pub collapse_factor: Option<f64>,
+    /// What ends the path there (`limit_point`, `strength`, `sliding`, …).
+    pub collapse_mode: Option<CollapseMode>,
+    /// The collapse check in full (imperfection, LBA, sag at λ = 1, steps).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collapse: Option<Collapse>,
 }
 
 /// The result (`buildability.json`).
@@ -483,6 +540,66 @@ pub fn check_layers_warm(
         ..Default::default()
     };
     let (g, mode) = check_state_warm(&mut model, &layers, &ages, &r.time, &opts, start)?;
+    let o = &r.spec.object;
+    let collapse = match (r.spec.nonlinear(), g.blf()) {
+        (Some(nl), Some(blf)) => {
+            let options = CollapseOptions {
+                w0: nl.amplitude(o.width, n as f64 * o.layer_height),
+                // A closed cylinder's modes are sign-symmetric (docs/collapse.md §1).
+                signs: nl.signs.unwrap_or(match o.kind {
+                    ObjectKind::Cylinder => 1,
+                    ObjectKind::Wall => 2,
+                }),
+                strength: c.strength && nl.material,
+                sliding: c.sliding && nl.material,
+            };
+            let shape = mode.clone().unwrap_or_default();
+            Some(collapse_factor(
+                &model,
+                &shape,
+                blf,
+                g.strength.map(|w| w.utilisation),
+                &layers,
+                &ages,
+                &r.time,
+                &options,
+            )?)
+        }
+        _ => None,
+    };
+    let (governing, failure) = match &collapse {
+        None => (g.governing, g.failure),
+        Some(col) => {
+            let u = |v: Option<f64>| v.filter(|x| !x.is_nan());
+            let candidates = [
+                (
+                    FailureMode::Buckling,
+                    u(g.blf().map(|b| {
+                        if b > 0.0 {
+                            c.blf_min / b
+                        } else {
+                            f64::INFINITY
+                        }
+                    })),
+                ),
+                (FailureMode::Strength, u(g.strength.map(|w| w.utilisation))),
+                (FailureMode::Sliding, u(g.sliding.map(|w| w.utilisation))),
+                (
+                    FailureMode::Collapse,
+                    Some(if col.factor > 0.0 {
+                        c.collapse_min / col.factor
+                    } else {
+                        f64::INFINITY
+                    }),
+                ),
+            ];
+            let gov = candidates
+                .iter()
+                .filter_map(|(m, u)| u.map(|u| (*m, u)))
+                .max_by(|a, b| a.1.total_cmp(&b.1));
+            (gov.map(|g| g.0), gov.filter(|(_, u)| *u > 1.0).map(|g| g.0))
+        }
+    };
     Ok((
         BuildState {
             layers: n,
@@ -495,8 +612,11 @@ pub fn check_layers_warm(
             strength_worst: g.strength,
             sliding_worst: g.sliding,
             buckling: g.buckling,
-            governing: g.governing,
-            failure: g.failure,
+            governing,
+            failure,
+            collapse_factor: collapse.as_ref().map(|x| x.factor),
+            collapse_mode: collapse.as_ref().map(|x| x.mode),
+            collapse,
         },
         mode,
     ))
@@ -631,8 +751,8 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
     );
     let _ = writeln!(
         t,
-        "  {:>5} {:>8} {:>9} {:>10} {:>9} {:>9}  governs",
-        "n", "H [m]", "age0 [s]", "BLF", "strength", "sliding"
+        "  {:>5} {:>8} {:>9} {:>10} {:>9} {:>9} {:>9}  governs",
+        "n", "H [m]", "age0 [s]", "BLF", "strength", "sliding", "collapse"
     );
     let f = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4}"));
     let step = (b.states.len() / 20).max(1);
@@ -640,20 +760,35 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
         if s.layers % step == 0 || s.failure.is_some() || s.layers == 1 {
             let _ = writeln!(
                 t,
-                "  {:>5} {:>8.3} {:>9.1} {:>10} {:>9} {:>9}  {}",
+                "  {:>5} {:>8.3} {:>9.1} {:>10} {:>9} {:>9} {:>9}  {}{}",
                 s.layers,
                 s.height_m,
                 s.bottom_age_s,
                 f(s.blf),
                 f(s.strength_utilisation),
                 f(s.sliding_utilisation),
-                s.governing.map_or("-", |m| m.name())
+                f(s.collapse_factor),
+                s.governing.map_or("-", |m| m.name()),
+                match (s.governing, s.collapse_mode) {
+                    (Some(FailureMode::Collapse), Some(m)) => format!(" ({})", m.name()),
+                    _ => String::new(),
+                }
             );
         }
     }
     match (b.failure_layer, b.failure_mode) {
         (Some(n), Some(m)) => {
-            let _ = writeln!(t, "fails at layer {n} by {}", m.name());
+            let failed = b.states.iter().find(|s| s.layers == n);
+            let how = match (m, failed.and_then(|s| s.collapse.as_ref())) {
+                (FailureMode::Collapse, Some(c)) => format!(
+                    " (collapse factor {:.3}, {}, w0 = {:.2} mm)",
+                    c.factor,
+                    c.mode.name(),
+                    c.w0 * 1e3
+                ),
+                _ => String::new(),
+            };
+            let _ = writeln!(t, "fails at layer {n} by {}{how}", m.name());
         }
         _ => {
             let _ = writeln!(t, "stands to {} layers", o.max_layers);

@@ -173,6 +173,11 @@ pub struct AnalysisOptions {
     /// length (issue 15). `None` (default): every layer is a row.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grading: Option<Grading>,
+    /// `[analysis.nonlinear]`: the collapse check (docs/collapse.md). `None` (default): off;
+    /// the table given (even empty): on, with the defaults of
+    /// [`crate::input::nonlinear::NonlinearSpec`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nonlinear: Option<crate::input::nonlinear::NonlinearSpec>,
 }
 
 impl Default for AnalysisOptions {
@@ -186,6 +191,7 @@ impl Default for AnalysisOptions {
             sturm_check: false,
             element: default_element(),
             grading: None,
+            nonlinear: None,
         }
     }
 }
@@ -198,6 +204,9 @@ impl AnalysisOptions {
             value,
             allowed: allowed.to_string(),
         };
+        if let Some(n) = &self.nonlinear {
+            n.validate()?;
+        }
         if self.modes == 0 || self.modes > 50 {
             return Err(bad(
                 "analysis.modes",

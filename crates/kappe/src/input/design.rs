@@ -165,6 +165,17 @@ pub struct ConstraintSpec {
     /// an `[uncertainty]` table. Default [`crate::input::uncertainty::BETA_MIN_DEFAULT`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta_min: Option<f64>,
+    /// Least collapse factor of the imperfect print states (`[analysis.nonlinear]`,
+    /// docs/collapse.md). Default 1.0: the state collapses under its own weight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_min: Option<f64>,
+}
+
+impl ConstraintSpec {
+    /// `collapse_min`, default 1.0.
+    pub fn collapse_min(&self) -> f64 {
+        self.collapse_min.unwrap_or(1.0)
+    }
 }
 
 /// Robot and tool settings for the motion planner (method.md §8, robot.md).
@@ -474,6 +485,7 @@ impl Default for ConstraintSpec {
             blf_min: 1.0,
             overhang_max: None,
             beta_min: None,
+            collapse_min: None,
         }
     }
 }
@@ -703,6 +715,14 @@ impl Design {
             k.blf_min > 0.0,
             "allowed: BLF_min > 0",
         )?;
+        if let Some(c) = k.collapse_min {
+            check(
+                "constraints.collapse_min",
+                c,
+                c.is_finite() && c > 0.0,
+                "allowed: collapse_min > 0 (1: collapse under the state's own weight)",
+            )?;
+        }
         if let Some(lo) = k.overhang_max {
             check(
                 "constraints.overhang_max",

@@ -8,6 +8,7 @@ pub mod analysis;
 pub mod design;
 pub mod error;
 pub mod material;
+pub mod nonlinear;
 pub mod resolve;
 pub mod schedule;
 pub mod uncertainty;

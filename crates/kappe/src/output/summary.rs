@@ -185,6 +185,14 @@ pub struct StateEntry {
     /// Age of the oldest layer at this state, s (with a time model).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bottom_age_s: Option<f64>,
+    /// Collapse factor of the imperfect state (only the states the collapse check ran,
+    /// docs/collapse.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_factor: Option<f64>,
+    /// What ends its path there: `limit_point`, `strength`, `sliding`, `mechanism`,
+    /// `not_reached`, `no_convergence`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse_mode: Option<String>,
     /// Every checked constraint holds in this state (absent without an analysis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ok: Option<bool>,
@@ -427,6 +435,10 @@ impl Outcome {
                     strength_utilisation: a.and_then(|a| a.strength_utilisation),
                     sliding_utilisation: a.and_then(|a| a.sliding_utilisation),
                     bottom_age_s: a.and_then(|a| a.bottom_age_s),
+                    collapse_factor: a.and_then(|a| a.collapse_factor),
+                    collapse_mode: a
+                        .and_then(|a| a.collapse_mode)
+                        .map(|m| m.name().to_string()),
                     ok: a.map(|a| a.ok),
                     mechanism: a.and_then(|a| a.mechanism.clone()),
                     beta: r.map(|r| r.beta),

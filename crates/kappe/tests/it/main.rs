@@ -5,6 +5,7 @@ mod analysis_loop;
 mod analysis_props;
 mod cap;
 mod ceiling;
+mod collapse;
 mod corrugation;
 mod ends;
 mod floors;

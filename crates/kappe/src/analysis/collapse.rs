@@ -1,0 +1,442 @@
+//! The collapse factor of a print state (docs/collapse.md): the geometrically nonlinear path of
+//! the imperfect state under λ × its self-weight (`kappe_fe::nonlinear_path`: co-rotational
+//! shells, arc length), with the aged material checked at every converged step in the deformed,
+//! bent state. The collapse factor is the smallest λ at which the path reaches a limit point
+//! (load maximum or bifurcation) or the material fails.
+//!
+//! **Imperfection.** The state's lowest linear buckling mode (the one the LBA check computed on
+//! the same model with the same aged moduli) scaled to the amplitude w0
+//! ([`crate::input::nonlinear::NonlinearSpec::amplitude`]), with one or both signs.
+//!
+//! **Material along the path.** Per element, the stresses at both faces z = ±t/2,
+//! σ = N/t ± 6M/t² from the deformational part of the facet's motion
+//! (`kappe_fe::deformed_resultants`), against the Mohr–Coulomb criterion and the bed-joint
+//! sliding check of [`crate::analysis::green`] at the age of the element's younger layer. The
+//! linear checks use the mid-surface (membrane) stress of the undeformed state; here the bending
+//! that the imperfection and its growth cause is what matters, so the faces are checked. The
+//! utilisation u(λ) is interpolated linearly between the last step with u ≤ 1 and the first
+//! with u > 1 (from u(0) = 0): the λ where it crosses 1 is the material's collapse factor.
+//!
+//! **Path options.** First load increment λ₁ = ½·min(λ_LBA, 1/u_lin) (u_lin: the linear
+//! strength utilisation at λ = 1, when known) so that the first step lands before either
+//! bound; the path ends at λ_max = 1.5·λ_LBA (an imperfect state's limit point lies below
+//! λ_LBA up to the co-rotational mesh's 1–3 % stiffer critical load, docs/nonlinear.md): a
+//! path that gets there without a limit point is reported as `not_reached` with that λ.
+
+use std::ops::ControlFlow;
+
+use kappe_fe::{PathOptions, ShellModel, StopReason};
+use serde::Serialize;
+
+use crate::analysis::green::{ElementLayers, bed_traction, principal};
+use crate::input::error::DesignError;
+use crate::input::material::TimeModel;
+
+/// What ended a state's path at its collapse factor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CollapseMode {
+    /// The path reached a limit point (load maximum or bifurcation): buckling.
+    LimitPoint,
+    /// Mohr–Coulomb strength failed at a face of the deformed shell.
+    Strength,
+    /// A bed joint slid in the deformed shell.
+    Sliding,
+    /// The state is a mechanism (collapse factor 0).
+    Mechanism,
+    /// The path reached λ_max = 1.5·λ_LBA without collapse: the factor is a lower bound.
+    NotReached,
+    /// The path stopped converging before any limit point: the factor is the last converged
+    /// λ (a lower bound).
+    NoConvergence,
+}
+
+impl CollapseMode {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            CollapseMode::LimitPoint => "limit_point",
+            CollapseMode::Strength => "strength",
+            CollapseMode::Sliding => "sliding",
+            CollapseMode::Mechanism => "mechanism",
+            CollapseMode::NotReached => "not_reached",
+            CollapseMode::NoConvergence => "no_convergence",
+        }
+    }
+}
+
+/// Options of [`collapse_factor`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CollapseOptions {
+    /// Imperfection amplitude w0, m (0: the perfect path).
+    pub w0: f64,
+    /// 1: the mode as given; 2: both signs, the lower factor kept.
+    pub signs: usize,
+    /// Check Mohr–Coulomb strength at the faces along the path.
+    pub strength: bool,
+    /// Check bed-joint sliding at the faces along the path.
+    pub sliding: bool,
+}
+
+/// The collapse of one state.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Collapse {
+    /// Collapse factor λ_c (multiplies the state's self-weight).
+    pub factor: f64,
+    /// What ended the path there.
+    pub mode: CollapseMode,
+    /// The linear buckling factor of the same model (the imperfection's source).
+    pub lba: f64,
+    /// Imperfection amplitude used, m.
+    pub w0: f64,
+    /// Sign of the mode that governs (+1 or −1).
+    pub sign: f64,
+    /// Largest translation relative to the imperfect geometry at the last converged step with
+    /// λ ≤ 1 (m; 0 if the first step is beyond 1): the state's sag under its own weight.
+    pub deflection_at_1: f64,
+    /// Converged steps of the governing path.
+    pub steps: usize,
+    /// Tangent assemblies over all paths run.
+    pub assemblies: usize,
+}
+
+/// The collapse factor of a state (module docs). `model` carries the aged moduli, supports and
+/// load of the state (as its LBA check used them); `mode` is its lowest buckling mode per node
+/// and `lba` its factor; `elements`/`ages`/`time` give each element's layer ages and strength.
+#[allow(clippy::too_many_arguments)]
+pub fn collapse_factor(
+    model: &ShellModel,
+    mode: &[[f64; 6]],
+    lba: f64,
+    linear_strength: Option<f64>,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &CollapseOptions,
+) -> Result<Collapse, DesignError> {
+    if !(lba.is_finite() && lba > 0.0) {
+        return Ok(Collapse {
+            factor: 0.0,
+            mode: CollapseMode::Mechanism,
+            lba,
+            w0: options.w0,
+            sign: 1.0,
+            deflection_at_1: 0.0,
+            steps: 0,
+            assemblies: 0,
+        });
+    }
+    let signs: &[f64] = if options.signs >= 2 {
+        &[1.0, -1.0]
+    } else {
+        &[1.0]
+    };
+    let mut best: Option<Collapse> = None;
+    let mut assemblies = 0;
+    for &sign in signs {
+        let c = one_path(
+            model,
+            mode,
+            lba,
+            linear_strength,
+            elements,
+            ages,
+            time,
+            options,
+            sign,
+        )?;
+        assemblies += c.assemblies;
+        if best.as_ref().is_none_or(|b| c.factor < b.factor) {
+            best = Some(c);
+        }
+        // A perfect path has no sign.
+        if options.w0 == 0.0 {
+            break;
+        }
+    }
+    let mut best = best.ok_or_else(|| DesignError::FormFinding("collapse: no path run".into()))?;
+    best.assemblies = assemblies;
+    Ok(best)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn one_path(
+    model: &ShellModel,
+    mode: &[[f64; 6]],
+    lba: f64,
+    linear_strength: Option<f64>,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &CollapseOptions,
+    sign: f64,
+) -> Result<Collapse, DesignError> {
+    let fe = |e: kappe_fe::FeError| DesignError::FormFinding(format!("collapse path: {e}"));
+    let imperfect = kappe_fe::with_imperfection(model, mode, sign * options.w0).map_err(fe)?;
+    let lam_mat = linear_strength
+        .filter(|u| u.is_finite() && *u > 0.0)
+        .map_or(f64::INFINITY, |u| 1.0 / u);
+    let opt = PathOptions {
+        initial_increment: 0.5 * lba.min(lam_mat),
+        lambda_max: 1.5 * lba,
+        ..Default::default()
+    };
+    let check_material = (options.strength || options.sliding) && time.strength.is_some();
+    let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
+    // (λ, utilisation, mode) of the last step at or below u = 1.
+    let mut last = (0.0, 0.0);
+    let mut material: Option<(f64, CollapseMode)> = None;
+    let mut deflection_at_1 = 0.0;
+    let mut material_error: Option<DesignError> = None;
+    let path = kappe_fe::nonlinear_path(&imperfect, &opt, &mut |step| {
+        if step.lambda <= 1.0 {
+            deflection_at_1 = step
+                .displacements
+                .iter()
+                .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+                .fold(0.0, f64::max);
+        }
+        if !check_material {
+            return ControlFlow::Continue(());
+        }
+        let res = match kappe_fe::deformed_resultants(&imperfect, &step.displacements) {
+            Ok(r) => r,
+            Err(e) => {
+                material_error = Some(fe(e));
+                return ControlFlow::Break(StopReason::Caller("resultants".into()));
+            }
+        };
+        let (mut us, mut ul) = (0.0f64, 0.0f64);
+        for (r, info) in res.iter().zip(elements) {
+            let Some(mc) = time.mohr_coulomb(age(info.younger)) else {
+                continue;
+            };
+            for top in [true, false] {
+                let s = r.surface_stress(top);
+                if options.strength {
+                    let (s1, s2) = principal(s[0], s[1], s[2]);
+                    us = us.max(mc.utilisation(s1, s2));
+                }
+                if options.sliding {
+                    let (sn, tau) = bed_traction(&r.frame, s, info.bed_normal);
+                    ul = ul.max(mc.sliding_utilisation(tau, sn));
+                }
+            }
+        }
+        let (u, m) = if us >= ul {
+            (us, CollapseMode::Strength)
+        } else {
+            (ul, CollapseMode::Sliding)
+        };
+        // A step with λ below the last one lies past a load maximum, which the path reports
+        // as its limit point (it comes first along the path).
+        if u > 1.0 && step.lambda > last.0 {
+            let (l0, u0) = last;
+            let lam = l0 + (1.0 - u0) / (u - u0) * (step.lambda - l0);
+            material = Some((lam.clamp(l0, step.lambda), m));
+            ControlFlow::Break(StopReason::Caller(m.name().into()))
+        } else if step.lambda > last.0 {
+            last = (step.lambda, u);
+            ControlFlow::Continue(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+    .map_err(fe)?;
+    if let Some(e) = material_error {
+        return Err(e);
+    }
+    let last_lambda = path.steps.last().map_or(0.0, |s| s.lambda);
+    let limit = path.limit.map(|l| l.lambda);
+    let (factor, cmode) = match (limit, material) {
+        (Some(l), Some((m, mm))) => {
+            if m < l {
+                (m, mm)
+            } else {
+                (l, CollapseMode::LimitPoint)
+            }
+        }
+        (Some(l), None) => (l, CollapseMode::LimitPoint),
+        (None, Some((m, mm))) => (m, mm),
+        (None, None) => match path.stop {
+            StopReason::LambdaMax => (last_lambda, CollapseMode::NotReached),
+            _ => (last_lambda, CollapseMode::NoConvergence),
+        },
+    };
+    Ok(Collapse {
+        factor,
+        mode: cmode,
+        lba,
+        w0: options.w0,
+        sign,
+        deflection_at_1,
+        steps: path.steps.len(),
+        assemblies: path.stats.assemblies,
+    })
+}
+
+/// A state's linear upper bound on its collapse factor, for [`cap_states_to_run`]: its LBA
+/// factor and the load factors 1/u at which its linear strength and sliding checks reach 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LinearBound {
+    /// State index.
+    pub state: usize,
+    /// min(BLF, 1/u_strength, 1/u_sliding).
+    pub bound: f64,
+}
+
+/// The knockdown floor of the state rule: the rule keeps running states while the next one's
+/// linear bound times this floor lies below the least collapse factor found
+/// (docs/collapse.md §3).
+pub const KNOCKDOWN_FLOOR: f64 = 0.5;
+
+/// The collapse factors of a cap's states (docs/collapse.md §3): the states in ascending order
+/// of their linear bound, in batches of the worker count, until the next state's bound times
+/// min(½, 0.8 × the least knockdown λ_c/bound seen) exceeds the least collapse factor found
+/// (`all`: every state with a bound). `run(state)` computes one state's collapse.
+pub fn cap_states_to_run(
+    bounds: &[LinearBound],
+    all: bool,
+    run: &(dyn Fn(usize) -> Result<Option<Collapse>, DesignError> + Sync),
+) -> Result<Vec<(usize, Collapse)>, DesignError> {
+    use rayon::prelude::*;
+    let mut order: Vec<LinearBound> = bounds
+        .iter()
+        .copied()
+        .filter(|b| b.bound.is_finite())
+        .collect();
+    order.sort_by(|a, b| a.bound.total_cmp(&b.bound));
+    let batch = rayon::current_num_threads().max(1);
+    let mut done: Vec<(usize, Collapse)> = Vec::new();
+    let mut least = f64::INFINITY;
+    let mut knockdown = 1.0f64;
+    let mut next = 0;
+    while next < order.len() {
+        let floor = KNOCKDOWN_FLOOR.min(0.8 * knockdown);
+        if !all && !done.is_empty() && order[next].bound * floor > least {
+            break;
+        }
+        let hi = (next + batch).min(order.len());
+        let part: Vec<(LinearBound, Option<Collapse>)> = order[next..hi]
+            .par_iter()
+            .map(|b| run(b.state).map(|c| (*b, c)))
+            .collect::<Result<_, DesignError>>()?;
+        for (b, c) in part {
+            if let Some(c) = c {
+                least = least.min(c.factor);
+                if b.bound > 0.0 {
+                    knockdown = knockdown.min(c.factor / b.bound);
+                }
+                done.push((b.state, c));
+            }
+        }
+        next = hi;
+    }
+    done.sort_by_key(|d| d.0);
+    Ok(done)
+}
+
+/// The collapse of one cap state (top print index `top`) on its full shell mesh: its LBA
+/// (mode 1 on the shell's nodes), the imperfection rule with the shell's thickness and the
+/// state's height above its lowest node, and the path with the aged material (`green`: the
+/// time model and ages; without one, the limit point only). `None`: no shell (one layer).
+pub fn cap_state_collapse(
+    cap: &crate::form::cap::Cap,
+    options: &crate::input::analysis::AnalysisOptions,
+    spec: &crate::input::nonlinear::NonlinearSpec,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+) -> Result<Option<Collapse>, DesignError> {
+    let state = crate::form::states::build_state(
+        &cap.sections,
+        &cap.frame,
+        cap.design.print.start_arch_fraction,
+        top,
+    )?;
+    let mat = crate::analysis::buckling::state_material_with(cap, options, top, green);
+    let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
+        return Ok(None);
+    };
+    let model = &shell.model;
+    let lba = match kappe_fe::buckling(
+        model,
+        &kappe_fe::BucklingOptions {
+            modes: 1,
+            // As the LBA check (buckling.rs): far below any modelling error.
+            tolerance: 1e-8,
+            ..Default::default()
+        },
+    ) {
+        Ok(r) => r,
+        Err(kappe_fe::FeError::Mechanism { .. }) => {
+            return Ok(Some(Collapse {
+                factor: 0.0,
+                mode: CollapseMode::Mechanism,
+                lba: 0.0,
+                w0: 0.0,
+                sign: 1.0,
+                deflection_at_1: 0.0,
+                steps: 0,
+                assemblies: 0,
+            }));
+        }
+        Err(e) => {
+            return Err(DesignError::State {
+                state: top,
+                message: format!("buckling solve for the collapse check failed: {e}"),
+            });
+        }
+    };
+    let (Some(&blf), Some(mode)) = (lba.factors.first(), lba.modes.first()) else {
+        return Ok(None);
+    };
+    let (zmin, zmax) = model
+        .nodes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[2]), b.max(p[2]))
+        });
+    let w0 = spec.amplitude(model.thickness_of(0), (zmax - zmin).max(0.0));
+    let (elements, ages, time) = match green {
+        Some(g) => (
+            g.element_layers(&shell),
+            g.schedule.ages(top + 1),
+            g.time.clone(),
+        ),
+        None => (Vec::new(), Vec::new(), cap.design.time_model()?),
+    };
+    let linear_strength = green
+        .and_then(|g| {
+            g.time
+                .strength
+                .is_some()
+                .then(|| kappe_fe::linear_static(model).ok())
+                .flatten()
+                .map(|st| {
+                    crate::analysis::green::stress_checks(
+                        &st,
+                        &elements,
+                        &ages,
+                        &g.time,
+                        &Default::default(),
+                    )
+                })
+        })
+        .and_then(|(s, _)| s.map(|w| w.utilisation));
+    collapse_factor(
+        model,
+        mode,
+        blf,
+        linear_strength,
+        &elements,
+        &ages,
+        &time,
+        &CollapseOptions {
+            w0,
+            signs: spec.signs.unwrap_or(2),
+            strength: spec.material,
+            sliding: spec.material,
+        },
+    )
+    .map(Some)
+}
