@@ -205,7 +205,7 @@ pub fn form_find_layer_with_segments(
     spec: &ArchSpec,
     segments: usize,
 ) -> Result<Arch, DesignError> {
-    if segments < 5 || segments % 2 == 0 {
+    if segments < 5 || segments.is_multiple_of(2) {
         return Err(DesignError::FormFinding(format!(
             "{segments} segments requested; allowed: an odd count ≥ 5"
         )));

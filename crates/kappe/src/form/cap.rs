@@ -126,7 +126,7 @@ fn corrugated_arches(
                 .segment_forces
                 .iter()
                 .enumerate()
-                .find(|(_, f)| !(**f < 0.0))
+                .find(|(_, f)| f.is_nan() || **f >= 0.0)
             {
                 return Err(DesignError::FormFinding(format!(
                     "corrugated centre layer {k} (rise {:.1} mm): segment {i} carries {f:.3e} N, \
