@@ -4,6 +4,7 @@ pub mod buildability;
 pub mod calibrate;
 pub mod cem;
 pub mod design;
+pub mod designer;
 pub mod fe;
 pub mod init;
 pub mod optimize;
