@@ -10,7 +10,7 @@
 # * wasm-bindgen-cli 0.2.130, the exact version of the `wasm-bindgen` crate (crates/designer/Cargo.toml
 #   pins it with `=`), by `cargo install` into target/designer-tools.
 # Outputs: crates/designer/pkg/kappe_designer.js (glue, --target no-modules) and
-# kappe_designer_bg.wasm. Build dir: $KAPPE_WASM_TARGET_DIR (default target/wasm).
+# kappe_designer_bg.wasm(.gz). Build dir: $KAPPE_WASM_TARGET_DIR (default target/wasm).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -47,4 +47,7 @@ PKG=crates/designer/pkg
 mkdir -p "$PKG"
 "$TOOLS/bin/wasm-bindgen" --target no-modules --no-typescript --out-dir "$PKG" \
   "$TARGET_DIR/wasm32-unknown-unknown/release/kappe_designer.wasm"
+# The page inlines the wasm gzip-compressed (base64), unpacked by the browser's
+# DecompressionStream: 4.9 MB of wasm would not fit the 5 MB page otherwise.
+gzip -9 -n -c "$PKG/kappe_designer_bg.wasm" > "$PKG/kappe_designer_bg.wasm.gz"
 ls -l "$PKG"

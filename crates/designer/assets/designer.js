@@ -8,15 +8,16 @@
 //
 // Test hook: window.kappeDesigner = { set(field, value), state(), designToml(), load(text) };
 // window.KAPPE_DESIGNER_READY once the first design is shown.
-(function () {
+(async function () {
   'use strict';
   const $ = (id) => document.getElementById(id);
   const THREE = window.THREE;
   const GLUE = $('kappe-glue').textContent;
   const WORKER_SRC = $('kappe-worker').textContent;
   const b64 = $('kappe-wasm').textContent.trim();
-  const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
-  const module = new WebAssembly.Module(bytes);
+  const gz = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+  const bytes = await new Response(new Blob([gz]).stream().pipeThrough(new DecompressionStream('gzip'))).arrayBuffer();
+  const module = await WebAssembly.compile(bytes);
   wasm_bindgen.initSync({ module });
   const session = new wasm_bindgen.Session();
 

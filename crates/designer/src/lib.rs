@@ -156,12 +156,12 @@ impl From<FeWire> for StateFe {
     }
 }
 
-/// Set `field` (dotted, e.g. `cap.rise`) of the TOML `text` to `value`; the new text. Tables on
-/// the way are created.
+/// Set `field` (dotted, e.g. `cap.rise`) of the TOML `text` to `value` (`null`: remove it, so it
+/// takes its default); the new text. Tables on the way are created.
 ///
 /// # Errors
 /// `text` is not TOML, `field` is empty or runs through a value that is not a table, or `value`
-/// is `null` or cannot be held by TOML.
+/// cannot be held by TOML.
 pub fn set_field(text: &str, field: &str, value: &Value) -> Result<String, FieldError> {
     let err = |message: String| FieldError {
         field: field.to_string(),
@@ -178,7 +178,10 @@ pub fn set_field(text: &str, field: &str, value: &Value) -> Result<String, Field
     if parts.iter().any(|p| p.is_empty()) {
         return Err(err("a field name is dotted words, e.g. cap.rise".into()));
     }
-    let new = to_toml(value).ok_or_else(|| {
+    let new = (!value.is_null())
+        .then(|| to_toml(value))
+        .map(|v| v.ok_or(()));
+    let new = new.transpose().map_err(|()| {
         err(format!(
             "{value} is not a value a design field can take (a number, true/false or text)"
         ))
@@ -193,7 +196,10 @@ pub fn set_field(text: &str, field: &str, value: &Value) -> Result<String, Field
             _ => return Err(err(format!("`{t}` is not a table"))),
         };
     }
-    table.insert((*last).to_string(), new);
+    match new {
+        Some(v) => table.insert((*last).to_string(), v),
+        None => table.remove(*last),
+    };
     toml::to_string(&doc).map_err(|e| err(format!("cannot write the design as TOML: {e}")))
 }
 

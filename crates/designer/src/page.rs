@@ -30,10 +30,11 @@ fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// The page, from the wasm-bindgen glue (`--target no-modules`) and the optimised wasm.
-pub fn page(glue: &str, wasm: &[u8]) -> String {
+/// The page, from the wasm-bindgen glue (`--target no-modules`) and the gzip-compressed wasm
+/// (the page unpacks it with the browser's `DecompressionStream`).
+pub fn page(glue: &str, wasm_gz: &[u8]) -> String {
     let esc = kappe_report::escape_inline_script;
-    let mut h = String::with_capacity(wasm.len() * 4 / 3 + 1_000_000);
+    let mut h = String::with_capacity(wasm_gz.len() * 4 / 3 + 1_000_000);
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
@@ -70,7 +71,7 @@ time model the layers' ages are those of path length / print speed and the waits
         three = esc(kappe_report::THREE_BUNDLE),
         glue_text = esc(glue),
         worker = esc(WORKER_JS),
-        wasm = base64(wasm),
+        wasm = base64(wasm_gz),
         glue = esc(glue),
         js = esc(DESIGNER_JS),
     );
