@@ -32,6 +32,8 @@ enum Command {
     Robot(cmd::robot::RobotCommand),
     /// Design a cap ceiling: form-find every print state, analyse, write outputs.
     Design(cmd::design::DesignArgs),
+    /// Write the designer: one offline page with the design's parameters as sliders, the cap in 3D and its checks live.
+    Designer(cmd::designer::DesignerArgs),
     /// Write a commented example file: a design (default), or --kind study|prototypes|optimize|buildability|ceiling|moving|corrugated.
     Init(cmd::init::InitArgs),
     /// Design study: run a grid or list of design variations (`kappe study merge` joins shards).
@@ -61,6 +63,7 @@ fn main() -> ExitCode {
         Command::Fe(c) => cmd::fe::run(c),
         Command::Robot(c) => cmd::robot::run(c),
         Command::Design(a) => cmd::design::run(a),
+        Command::Designer(a) => cmd::designer::run(a),
         Command::Init(a) => cmd::init::init(a),
         Command::Study(c) => cmd::study::run(c),
         Command::Calibrate(a) => cmd::calibrate::run(a),

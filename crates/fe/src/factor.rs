@@ -32,8 +32,16 @@ pub(crate) enum LltFailure {
     Other(FeError),
 }
 
+/// faer's parallelism: rayon natively; sequential on wasm32 (the designer in the browser runs
+/// one state per Web Worker, and faer's rayon feature does not build there).
+#[cfg(not(target_arch = "wasm32"))]
 fn par() -> Par {
     Par::rayon(0)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn par() -> Par {
+    Par::Seq
 }
 
 impl Symbolic {

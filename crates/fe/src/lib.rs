@@ -47,6 +47,7 @@
 
 pub mod assembly;
 pub mod ccx;
+pub mod clock;
 pub mod element;
 pub mod error;
 mod factor;

@@ -17,7 +17,7 @@
 //! factors found (a repeated or missed eigenvalue), Lanczos is restarted K-orthogonal to the
 //! modes already found until the counts agree.
 
-use std::time::Instant;
+use crate::clock::Instant;
 
 use faer::Mat;
 use nalgebra::{DMatrix, SymmetricEigen};

@@ -182,7 +182,7 @@ pub fn run(
     let states = Ticker::new(on_progress, &stop, Stage::States);
     let cap = crate::form::cap::design_cap_until(design, &|total| states.tick(total), &stop)?;
     check(&stop)?;
-    evaluate_until(cap, options, on_progress, &stop)
+    evaluate_until(cap, options, on_progress, &stop, None)
 }
 
 /// The pipeline after form-finding (see [`run`]): analysis, robot plan, verdict.
@@ -194,7 +194,29 @@ pub fn evaluate(
     options: &Options,
     on_progress: OnProgress<'_>,
 ) -> Result<Outcome, DesignError> {
-    evaluate_until(cap, options, on_progress, &AtomicBool::new(false))
+    evaluate_until(cap, options, on_progress, &AtomicBool::new(false), None)
+}
+
+/// [`evaluate`] with the finite-element results of the analysed states computed elsewhere
+/// ([`crate::analysis::check::state_fe`] over [`crate::analysis::check::fe_runs`]: the
+/// designer's Web Workers), so the designer's verdict is the one `kappe design` reaches. States
+/// missing from `fe` count as not analysed. Plan no robot here (`options.robot = false`) when
+/// `fe` was computed on the schedule without a plan ([`crate::schedule::cap_schedule`]).
+///
+/// # Errors
+/// As [`evaluate`].
+pub fn evaluate_given(
+    cap: Cap,
+    options: &Options,
+    fe: Vec<crate::analysis::check::StateFe>,
+) -> Result<Outcome, DesignError> {
+    evaluate_until(
+        cap,
+        options,
+        &no_progress,
+        &AtomicBool::new(false),
+        Some(fe),
+    )
 }
 
 fn evaluate_until(
@@ -202,6 +224,7 @@ fn evaluate_until(
     options: &Options,
     on_progress: OnProgress<'_>,
     stop: &AtomicBool,
+    given: Option<Vec<crate::analysis::check::StateFe>>,
 ) -> Result<Outcome, DesignError> {
     // The robot is planned first (planning does not depend on the analysis): with a plan, the
     // structural check takes every layer's age from the plan's clock (issue 11). Programs are
@@ -239,15 +262,21 @@ fn evaluate_until(
     check(stop)?;
     let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
-    let analysis = match &options.analysis {
-        Some(o) => Some(crate::analysis::check::analyze_scheduled(
+    let analysis = match (&options.analysis, given) {
+        (Some(o), Some(given)) => Some(crate::analysis::check::analyze_given(
+            &cap,
+            o,
+            Some(&schedule),
+            given,
+        )?),
+        (Some(o), None) => Some(crate::analysis::check::analyze_scheduled(
             &cap,
             o,
             Some(&schedule),
             &|total| fe.tick(total),
             stop,
         )?),
-        None => None,
+        (None, _) => None,
     };
     check(stop)?;
     // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.

@@ -5,6 +5,7 @@ pub mod calibrate;
 pub mod cem;
 pub mod corrugation;
 pub mod design;
+pub mod designer;
 pub mod fe;
 pub mod init;
 pub mod optimize;

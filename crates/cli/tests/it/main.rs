@@ -6,6 +6,7 @@ mod collapse;
 mod common;
 mod corrugation;
 mod design;
+mod designer;
 mod fe;
 mod formats;
 mod green;

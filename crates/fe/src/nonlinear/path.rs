@@ -1,8 +1,8 @@
 //! Path following: load-controlled Newton–Raphson and Crisfield's cylindrical arc length
 //! (formulas in the module docs of [`crate::nonlinear`]).
 
+use crate::clock::Instant;
 use std::ops::ControlFlow;
-use std::time::Instant;
 
 use faer::Mat;
 

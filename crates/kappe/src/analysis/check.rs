@@ -1,8 +1,8 @@
 //! [`analyze`]: every print state of a cap against every constraint (σ_min, σ_max, BLF_min,
 //! l_o,max), and the constraint report (see the [module docs](super)).
 
+use kappe_fe::clock::Instant;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
@@ -234,6 +234,139 @@ fn keep_max(w: &mut Option<Worst>, value: f64, state: usize, element: impl FnOnc
     }
 }
 
+/// The green-state checks of one state: the worst strength and the worst bed-joint sliding
+/// element (each `None` when not checked).
+pub type GreenChecks = (
+    Option<crate::analysis::green::WorstElement>,
+    Option<crate::analysis::green::WorstElement>,
+);
+
+/// The finite-element part of one state's analysis ([`state_fe`]): what [`analyze`] computes per
+/// selected state in parallel, and what the designer in the browser computes in its Web
+/// Workers and hands to [`analyze_given`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct StateFe {
+    /// State index (top print index).
+    pub state: usize,
+    /// The buckling analysis.
+    pub buckling: StateBuckling,
+    /// Mode 1 per shell node (empty when none).
+    pub mode: NetworkMode,
+    /// The green-state checks (only with a strength model).
+    pub green: Option<GreenChecks>,
+    /// Seconds spent (build + solve).
+    pub seconds: f64,
+}
+
+/// The green-state model of the analysis (issue 11): the layers' ages on `schedule`, `None`
+/// when the time model is constant and has no strength (then nothing depends on the ages).
+///
+/// # Errors
+/// An invalid time model or a `[schedule]` that does not fit the print.
+pub fn analysis_green(
+    cap: &Cap,
+    schedule: Option<&crate::schedule::Schedule>,
+) -> Result<Option<crate::analysis::green::CapGreen>, DesignError> {
+    let green = crate::analysis::green::CapGreen::with_schedule(cap, schedule)?;
+    Ok((green.time.strength.is_some() || !green.time.is_constant()).then_some(green))
+}
+
+/// The selected states of the buckling analysis in the runs [`analyze`] solves them in: with a
+/// graded mesh, contiguous runs of consecutive states (each state warm-started from the one
+/// before it in its run), else one state per run; largest first.
+pub fn fe_runs(options: &AnalysisOptions, total: usize) -> Vec<Vec<usize>> {
+    let mut selected = vec![false; total];
+    if options.buckling {
+        for i in options.states.indices(total) {
+            if let Some(x) = selected.get_mut(i) {
+                *x = true;
+            }
+        }
+    }
+    let order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
+    if options.grading.is_some() {
+        order
+            .chunks(WARM_RUN)
+            .rev()
+            .map(<[usize]>::to_vec)
+            .collect()
+    } else {
+        order.iter().rev().map(|&i| vec![i]).collect()
+    }
+}
+
+/// The finite-element analysis of state `top` (shell buckling, and the green-state strength
+/// checks with a strength model): one step of a run of [`fe_runs`]. `guess` carries the warm
+/// start from the run's previous state (start each run with `None`); `green` is
+/// [`analysis_green`] of the run's schedule.
+///
+/// # Errors
+/// A state that cannot be built or solved.
+pub fn state_fe(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    guess: &mut Option<ModeGuess>,
+) -> Result<StateFe, DesignError> {
+    let t0 = Instant::now();
+    let phi = cap.design.print.start_arch_fraction;
+    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+    let mat = state_material_with(cap, options, top, green);
+    // With a strength model the buckling solve's own static solution gives the membrane
+    // stresses (one factorization per state, not two).
+    let checked = match green {
+        Some(g) => g.state_checks(&state, &mat, options, top)?,
+        None => None,
+    };
+    let (buckling, mode, green) = match checked {
+        Some(c) => c,
+        _ if options.grading.is_some() => {
+            let (b, mode, next) = state_buckling_warm(&state, &mat, options, guess.as_ref())?;
+            *guess = Some(next);
+            (b, mode, None)
+        }
+        _ => {
+            let (b, mode) = state_buckling_mode(&state, &mat, options)?;
+            (b, mode, None)
+        }
+    };
+    Ok(StateFe {
+        state: top,
+        buckling,
+        mode,
+        green,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// [`analyze`] with the finite-element results of the selected states computed elsewhere
+/// ([`state_fe`] over [`fe_runs`], e.g. in the designer's Web Workers): the stresses, the
+/// overhangs, the constraint report and the verdict from them, exactly as [`analyze`] makes
+/// them. A selected state missing from `fe` counts as not analysed (the designer's partial
+/// verdict while its workers run).
+///
+/// # Errors
+/// Invalid options, a state that cannot be built.
+pub fn analyze_given(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    schedule: Option<&crate::schedule::Schedule>,
+    fe: Vec<StateFe>,
+) -> Result<Analysis, DesignError> {
+    options.validate()?;
+    let green = analysis_green(cap, schedule)?;
+    let t_all = Instant::now();
+    assemble(
+        cap,
+        options,
+        green,
+        fe,
+        (t_all, 0.0),
+        &AtomicBool::new(false),
+    )
+}
+
 /// Analyse every state of `cap` (see the module docs). `on_state(n)` is called once per
 /// buckling analysis finished (for a progress bar), with the number `n` of them.
 pub fn analyze(
@@ -265,6 +398,7 @@ pub(crate) fn analyze_scheduled(
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     options.validate()?;
+    let t_all = Instant::now();
     let cancelled = || {
         if stop.load(Ordering::Relaxed) {
             Err(DesignError::Cancelled)
@@ -272,22 +406,60 @@ pub(crate) fn analyze_scheduled(
             Ok(())
         }
     };
-    let t_all = Instant::now();
+    // Green state (issue 11): strength and bed-joint sliding with the layers' ages, only when
+    // `[material.time]` gives a strength model (otherwise nothing changes).
+    let green = analysis_green(cap, schedule)?;
+    // The buckling analysis of the selected states, largest first so the two cores finish
+    // together. With a graded mesh (issue 15) consecutive states share most of their mesh, so
+    // each state's eigensolve starts from the previous state's mode: the selected states run in
+    // contiguous runs, one after another within a run, the runs in parallel (largest first).
+    // The start changes the Lanczos steps, not the converged result (`state_buckling_warm`).
+    // The green-state strength path (`CapGreen::state_checks`) starts cold.
+    let t_phase = Instant::now();
+    let runs = fe_runs(options, cap.states.len());
+    let n_fe = runs.iter().map(Vec::len).sum();
+    let fe: Vec<StateFe> = runs
+        .into_par_iter()
+        .map(|run| {
+            let mut guess: Option<ModeGuess> = None;
+            let mut out = Vec::with_capacity(run.len());
+            for top in run {
+                cancelled()?;
+                out.push(state_fe(cap, options, green.as_ref(), top, &mut guess)?);
+                on_state(n_fe);
+            }
+            Ok(out)
+        })
+        .collect::<Result<Vec<_>, DesignError>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    let wall_fe = t_phase.elapsed().as_secs_f64();
+    assemble(cap, options, green, fe, (t_all, wall_fe), stop)
+}
+
+/// Phase 1 (every state's force pass and element stresses) and the report of [`analyze`], with
+/// the finite-element results `fe`; `clock`: when the analysis started and the wall-clock
+/// seconds of the finite-element phase.
+fn assemble(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<crate::analysis::green::CapGreen>,
+    fe: Vec<StateFe>,
+    (t_all, wall_fe): (Instant, f64),
+    stop: &AtomicBool,
+) -> Result<Analysis, DesignError> {
+    let cancelled = || {
+        if stop.load(Ordering::Relaxed) {
+            Err(DesignError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
     let design = &cap.design;
     let total = cap.states.len();
     let areas = cap.areas();
     let phi = design.print.start_arch_fraction;
-    let selected: Vec<bool> = {
-        let mut s = vec![false; total];
-        if options.buckling {
-            for i in options.states.indices(total) {
-                if let Some(x) = s.get_mut(i) {
-                    *x = true;
-                }
-            }
-        }
-        s
-    };
 
     struct PerState {
         stresses: StressExtremes,
@@ -298,14 +470,6 @@ pub(crate) fn analyze_scheduled(
         top_layer: i32,
         green: Option<GreenChecks>,
     }
-    type GreenChecks = (
-        Option<crate::analysis::green::WorstElement>,
-        Option<crate::analysis::green::WorstElement>,
-    );
-    // Green state (issue 11): strength and bed-joint sliding with the layers' ages, only when
-    // `[material.time]` gives a strength model (otherwise nothing changes).
-    let green = crate::analysis::green::CapGreen::with_schedule(cap, schedule)?;
-    let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
     // Phase 1: every state's force pass and element stresses (cheap). Against an end wall the
     // final state's force pass gives every state's extremes (`extremes_by_depth`: linear, not
     // quadratic, in the bay length).
@@ -355,72 +519,12 @@ pub(crate) fn analyze_scheduled(
             .collect::<Result<_, DesignError>>()?
     };
     let wall_stresses = t_phase.elapsed().as_secs_f64();
-    // Phase 2: the buckling analysis of the selected states, largest first so the two cores
-    // finish together.
-    let t_phase = Instant::now();
-    let order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
-    let n_fe = order.len();
-    // With a graded mesh (issue 15) consecutive states share most of their mesh, so each state's
-    // eigensolve starts from the previous state's mode: the selected states run in contiguous
-    // runs, one after another within a run, the runs in parallel (largest first). The start
-    // changes the Lanczos steps, not the converged result (`state_buckling_warm`). The
-    // green-state strength path (`CapGreen::state_checks`) starts cold.
-    let warm = options.grading.is_some();
-    let runs: Vec<Vec<usize>> = if warm {
-        order
-            .chunks(WARM_RUN)
-            .rev()
-            .map(<[usize]>::to_vec)
-            .collect()
-    } else {
-        order.iter().rev().map(|&i| vec![i]).collect()
-    };
-    #[allow(clippy::type_complexity)]
-    let fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> = runs
-        .into_par_iter()
-        .map(|run| {
-            let mut guess: Option<ModeGuess> = None;
-            let mut out = Vec::with_capacity(run.len());
-            for top in run {
-                cancelled()?;
-                let t0 = Instant::now();
-                let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-                let mat = state_material_with(cap, options, top, green.as_ref());
-                // With a strength model the buckling solve's own static solution gives the
-                // membrane stresses (one factorization per state, not two).
-                let checked = match &green {
-                    Some(g) => g.state_checks(&state, &mat, options, top)?,
-                    None => None,
-                };
-                let (b, mode, g) = match checked {
-                    Some(c) => c,
-                    _ if warm => {
-                        let (b, mode, next) =
-                            state_buckling_warm(&state, &mat, options, guess.as_ref())?;
-                        guess = Some(next);
-                        (b, mode, None)
-                    }
-                    _ => {
-                        let (b, mode) = state_buckling_mode(&state, &mat, options)?;
-                        (b, mode, None)
-                    }
-                };
-                on_state(n_fe);
-                out.push((top, b, mode, g, t0.elapsed().as_secs_f64()));
-            }
-            Ok(out)
-        })
-        .collect::<Result<Vec<_>, DesignError>>()?
-        .into_iter()
-        .flatten()
-        .collect();
-    let wall_fe = t_phase.elapsed().as_secs_f64();
-    for (top, b, mode, g, secs) in fe {
-        if let Some(p) = per.get_mut(top) {
-            p.buckling = Some(b);
-            p.green = g;
-            p.mode = mode;
-            p.fe_seconds = secs;
+    for f in fe {
+        if let Some(p) = per.get_mut(f.state) {
+            p.buckling = Some(f.buckling);
+            p.green = f.green;
+            p.mode = f.mode;
+            p.fe_seconds = f.seconds;
         }
     }
 

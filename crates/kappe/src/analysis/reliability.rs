@@ -290,7 +290,7 @@ pub fn reliability(
     let Some(table) = &cap.design.uncertainty else {
         return Ok(None);
     };
-    let t0 = std::time::Instant::now();
+    let t0 = kappe_fe::clock::Instant::now();
     let model = table.model(&cap.design)?;
     let drifts = table.drifts();
     let v = Vars::of(&model, cap);

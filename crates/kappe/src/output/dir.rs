@@ -587,6 +587,7 @@ fn normalize(path: &Path) -> PathBuf {
 }
 
 /// Swap two paths atomically (Linux `renameat2(RENAME_EXCHANGE)`).
+#[cfg(not(target_arch = "wasm32"))]
 fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
     rustix::fs::renameat_with(
         rustix::fs::CWD,
@@ -596,6 +597,13 @@ fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
         rustix::fs::RenameFlags::EXCHANGE,
     )
     .map_err(std::io::Error::from)
+}
+
+/// No file system on wasm32 (the designer in the browser writes nothing): the caller's
+/// two-rename fallback.
+#[cfg(target_arch = "wasm32")]
+fn exchange(_: &Path, _: &Path) -> std::io::Result<()> {
+    Err(std::io::ErrorKind::Unsupported.into())
 }
 
 #[cfg(test)]

@@ -1,0 +1,19 @@
+// Kappe designer Web Worker (appended to the wasm-bindgen glue in a Blob URL): the buckling
+// analysis of the print states of one run of `fe_runs`, by `kappe_designer::Worker`
+// (kappe::analysis::check::state_fe). Messages in: { module } once, then
+// { generation, text, run }. Out: { generation, result } per state, { done } per run.
+let worker = null;
+self.onmessage = (ev) => {
+  const m = ev.data;
+  if (m.module) {
+    wasm_bindgen.initSync({ module: m.module });
+    worker = new wasm_bindgen.Worker();
+    return;
+  }
+  try {
+    worker.run(m.text, Uint32Array.from(m.run), (result) => self.postMessage({ generation: m.generation, result }));
+    self.postMessage({ done: m.generation });
+  } catch (e) {
+    self.postMessage({ done: m.generation, error: String(e) });
+  }
+};

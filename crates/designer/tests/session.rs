@@ -1,0 +1,96 @@
+//! The designer's session and workers (natively; the same code runs in the browser) reach the
+//! numbers of `kappe::run` (what `kappe design --no-robot` runs): every state's BLF, the
+//! verdict and the constraint table, exactly (one library, one code path, same machine).
+//! And a bad value keeps the last good design and names its field.
+
+use kappe_designer::{SessionCore, WorkerCore, set_field};
+use serde_json::{Value, json};
+
+/// A short cap with buckling every 6th state: quick, and still a real analysis.
+const SHORT: &str = "[cap]\nlength = 0.15\n[analysis]\nstates = \"every:6\"\n";
+
+#[test]
+fn session_with_worker_results_equals_run() {
+    let mut session = SessionCore::new();
+    let loaded = session.load(SHORT).expect("design loads");
+    assert_eq!(loaded["report"]["states_done"], json!(0));
+    assert_eq!(
+        loaded["report"]["ok"],
+        Value::Null,
+        "no verdict before buckling"
+    );
+    let runs: Vec<Vec<usize>> = serde_json::from_value(loaded["runs"].clone()).expect("runs");
+    let generation = loaded["generation"].as_u64().expect("generation");
+    let mut worker = WorkerCore::new();
+    let mut report = Value::Null;
+    for run in &runs {
+        let mut results = Vec::new();
+        worker
+            .run(session.text(), run, &mut |s| results.push(s))
+            .expect("worker run");
+        for r in results {
+            report = session.add_fe(generation, &r).expect("results taken");
+        }
+    }
+    assert_eq!(report["complete"], json!(true));
+
+    let design = kappe::Design::from_toml_str(SHORT).expect("design");
+    let options = kappe::Options {
+        robot: false,
+        ..kappe::Options::of(&design)
+    };
+    let outcome = kappe::run(&design, &options, &kappe::no_progress).expect("run");
+    let analysis = outcome.analysis.as_ref().expect("analysis");
+    assert_eq!(report["ok"], json!(outcome.verdict.ok));
+    assert_eq!(report["min_blf"], json!(outcome.min_blf()));
+    let states = report["states"].as_array().expect("states");
+    assert_eq!(states.len(), analysis.states.len());
+    for (page, native) in states.iter().zip(&analysis.states) {
+        assert_eq!(page["blf"], json!(native.blf), "state {}", native.index);
+        assert_eq!(
+            page["compression_pa"],
+            json!(native.max_compression_stress_pa)
+        );
+    }
+    assert_eq!(
+        report["constraints"],
+        serde_json::to_value(&analysis.constraints).expect("json")
+    );
+}
+
+#[test]
+fn a_bad_value_names_its_field_and_keeps_the_design() {
+    let mut session = SessionCore::new();
+    session.load(SHORT).expect("design loads");
+    let before = session.text().to_string();
+    let e = session
+        .set("cap.rise", &json!(-0.1))
+        .expect_err("negative rise");
+    assert_eq!(e.field, "cap.rise");
+    assert!(e.message.contains("cap.rise"), "{}", e.message);
+    assert_eq!(session.text(), before);
+    let e = session
+        .set("print.layer_width", &json!("wide"))
+        .expect_err("text width");
+    assert_eq!(e.field, "print.layer_width", "{}", e.message);
+    assert_eq!(session.text(), before);
+    let e = session.load("[cap\nspan = 1").expect_err("not TOML");
+    assert!(
+        e.message.contains("TOML") || e.message.contains("expected"),
+        "{}",
+        e.message
+    );
+    assert_eq!(session.text(), before);
+}
+
+#[test]
+fn set_field_writes_dotted_fields() {
+    let t = set_field("[cap]\nrise = 0.2\n", "cap.rise", &json!(0.22)).expect("set");
+    assert!(t.contains("rise = 0.22"), "{t}");
+    let t = set_field(&t, "material.time.preset", &json!("earth")).expect("set");
+    assert!(t.contains("preset = \"earth\""), "{t}");
+    assert!(set_field(&t, "cap.rise.x", &json!(1)).is_err());
+    assert!(set_field(&t, "cap..rise", &json!(1)).is_err());
+    let t = set_field(&t, "material.time.preset", &Value::Null).expect("remove");
+    assert!(!t.contains("preset"), "{t}");
+}
