@@ -47,6 +47,7 @@
 
 pub mod assembly;
 pub mod ccx;
+pub mod convergence;
 pub mod element;
 pub mod error;
 mod factor;
@@ -55,9 +56,11 @@ pub mod mesh_json;
 pub mod model;
 pub mod nonlinear;
 pub mod oracle;
+pub mod refine;
 mod solver;
 pub mod summary;
 
+pub use convergence::{ConvergedFactor, MeshLevel, converge_factor};
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use nonlinear::{

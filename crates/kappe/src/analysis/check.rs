@@ -8,8 +8,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_mode,
-    state_buckling_warm, state_material_with,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm,
+    state_material_with,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -30,8 +30,29 @@ pub struct StateAnalysis {
     pub index: usize,
     /// Id of the top layer.
     pub top_layer: i32,
-    /// Lowest positive buckling factor (None: not analysed, no shell or mechanism).
+    /// Lowest positive buckling factor (None: not analysed, no shell or mechanism): the
+    /// converged estimate when `AnalysisOptions::converged_blf` (the safe end of its bracket,
+    /// docs/convergence.md), else the shell mesh's own factor.
     pub blf: Option<f64>,
+    /// The print-layer shell mesh's own factor (the `blf` of Kappe before issue 23), when the
+    /// mesh error is controlled.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_mesh: Option<f64>,
+    /// Relative error estimate of `blf`: the converged factor lies in
+    /// [blf, blf·(1 + blf_error)] (docs/convergence.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_error: Option<f64>,
+    /// `blf_error ≤ AnalysisOptions::blf_tolerance`. A state left unconverged cannot govern:
+    /// its safe-side factor is above the governing state's converged bracket.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_converged: Option<bool>,
+    /// Splits per edge of the finest mesh solved (2: the print-layer mesh and its 2×2 split).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_split: Option<usize>,
+    /// The split mesh was not solved in this state: its correction is interpolated between
+    /// solved neighbours (`crate::analysis::convergence`; such a state cannot govern).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_interpolated: Option<bool>,
     /// All factors found (ascending).
     pub blf_modes: Vec<f64>,
     /// What the buckling analysis did.
@@ -353,55 +374,128 @@ pub(crate) fn analyze_scheduled(
     // runs, one after another within a run, the runs in parallel (largest first). The start
     // changes the Lanczos steps, not the converged result (`state_buckling_warm`). The
     // green-state strength path (`CapGreen::state_checks`) starts cold.
-    let warm = options.grading.is_some();
-    let runs: Vec<Vec<usize>> = if warm {
-        order
-            .chunks(WARM_RUN)
-            .rev()
-            .map(<[usize]>::to_vec)
-            .collect()
-    } else {
-        order.iter().rev().map(|&i| vec![i]).collect()
+    // Each state's eigensolve starts from the previous state's mode (graded or full mesh: the
+    // mode guess is keyed by layer and position in the layer): the selected states run in
+    // contiguous runs, one after another within a run, the runs in parallel (largest first).
+    // The start changes the Lanczos steps, not the converged result (`state_buckling_warm`).
+    // The green-state strength path (`CapGreen::state_checks`) starts cold.
+    //
+    // With the mesh error controlled (issue 23) the first pass stops at the 2×2 split; the
+    // states that could still govern and are not converged to the tolerance are refined
+    // further in a second pass (below).
+    let first_pass = AnalysisOptions {
+        blf_max_split: 1,
+        ..options.clone()
+    };
+    let runs: Vec<Vec<usize>> = order
+        .chunks(WARM_RUN)
+        .rev()
+        .map(<[usize]>::to_vec)
+        .collect();
+    let solve_runs = |runs: Vec<Vec<usize>>, options: &AnalysisOptions| {
+        runs.into_par_iter()
+            .map(|run| {
+                let mut guess: Option<ModeGuess> = None;
+                let mut out = Vec::with_capacity(run.len());
+                for top in run {
+                    cancelled()?;
+                    let t0 = Instant::now();
+                    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+                    let mat = state_material_with(cap, options, top, green.as_ref());
+                    // With a strength model the buckling solve's own static solution gives the
+                    // membrane stresses (one factorization per state, not two).
+                    let checked = match &green {
+                        Some(g) => g.state_checks(&state, &mat, options, top)?,
+                        None => None,
+                    };
+                    let (b, mode, g) = match checked {
+                        Some(c) => c,
+                        _ => {
+                            let (b, mode, next) =
+                                state_buckling_warm(&state, &mat, options, guess.as_ref())?;
+                            guess = Some(next);
+                            (b, mode, None)
+                        }
+                    };
+                    on_state(n_fe);
+                    out.push((top, b, mode, g, t0.elapsed().as_secs_f64()));
+                }
+                Ok(out)
+            })
+            .collect::<Result<Vec<_>, DesignError>>()
+            .map(|v| v.into_iter().flatten().collect::<Vec<_>>())
     };
     #[allow(clippy::type_complexity)]
-    let fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> = runs
-        .into_par_iter()
-        .map(|run| {
-            let mut guess: Option<ModeGuess> = None;
-            let mut out = Vec::with_capacity(run.len());
-            for top in run {
-                cancelled()?;
-                let t0 = Instant::now();
-                let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-                let mat = state_material_with(cap, options, top, green.as_ref());
-                // With a strength model the buckling solve's own static solution gives the
-                // membrane stresses (one factorization per state, not two).
-                let checked = match &green {
-                    Some(g) => g.state_checks(&state, &mat, options, top)?,
-                    None => None,
-                };
-                let (b, mode, g) = match checked {
-                    Some(c) => c,
-                    _ if warm => {
-                        let (b, mode, next) =
-                            state_buckling_warm(&state, &mat, options, guess.as_ref())?;
-                        guess = Some(next);
-                        (b, mode, None)
-                    }
-                    _ => {
-                        let (b, mode) = state_buckling_mode(&state, &mat, options)?;
-                        (b, mode, None)
-                    }
-                };
-                on_state(n_fe);
-                out.push((top, b, mode, g, t0.elapsed().as_secs_f64()));
+    let mut fe: Vec<(usize, StateBuckling, NetworkMode, Option<GreenChecks>, f64)> =
+        solve_runs(runs, &first_pass)?;
+    let mut interpolated: Vec<usize> = Vec::new();
+    if options.converged_blf {
+        // The mesh error (docs/convergence.md): the 2×2 split on an adaptive sample of the
+        // states, the others' correction interpolated (`super::convergence::sample`).
+        let split_opts = AnalysisOptions {
+            blf_max_split: 2,
+            ..options.clone()
+        };
+        let mut coarse: Vec<(usize, f64)> = fe
+            .iter()
+            .filter(|(_, b, ..)| b.status == BucklingStatus::Analysed)
+            .filter_map(|(top, b, ..)| Some((*top, *b.factors.first()?)))
+            .collect();
+        // In print order: the runs come back largest first.
+        coarse.sort_unstable_by_key(|c| c.0);
+        let mut extra_secs: std::collections::HashMap<usize, f64> = Default::default();
+        let mut solve = |batch: &[usize], opts: &AnalysisOptions| {
+            let r = solve_runs(batch.iter().map(|&i| vec![i]).collect(), opts)?;
+            Ok::<_, DesignError>(
+                r.into_iter()
+                    .filter_map(|(top, b, _, _, secs)| {
+                        *extra_secs.entry(top).or_default() += secs;
+                        Some((top, b.convergence?))
+                    })
+                    .collect::<Vec<_>>(),
+            )
+        };
+        let sampled = super::convergence::sample(&coarse, options.blf_tolerance, &mut |b| {
+            solve(b, &split_opts)
+        })?;
+        let mut est: std::collections::BTreeMap<usize, (kappe_fe::ConvergedFactor, bool)> =
+            sampled.into_iter().map(|(i, c, s)| (i, (c, s))).collect();
+        // The states that could govern: solved, and converged to the tolerance.
+        for _ in 0..4 {
+            let upper = est.values().map(|(c, _)| c.upper).fold(f64::INFINITY, f64::min);
+            let interp: Vec<usize> = est
+                .iter()
+                .filter(|(_, (c, s))| !*s && c.extrapolated <= upper)
+                .map(|(i, _)| *i)
+                .collect();
+            let coarse_only: Vec<usize> = est
+                .iter()
+                .filter(|(_, (c, s))| {
+                    *s && !c.converged && c.extrapolated <= upper && options.blf_max_split > 2
+                        && c.levels.last().is_some_and(|l| l.split < options.blf_max_split)
+                })
+                .map(|(i, _)| *i)
+                .collect();
+            if interp.is_empty() && coarse_only.is_empty() {
+                break;
             }
-            Ok(out)
-        })
-        .collect::<Result<Vec<_>, DesignError>>()?
-        .into_iter()
-        .flatten()
-        .collect();
+            for (i, c) in solve(&interp, &split_opts)? {
+                est.insert(i, (c, true));
+            }
+            for (i, c) in solve(&coarse_only, options)? {
+                est.insert(i, (c, true));
+            }
+        }
+        for (top, b, _, _, secs) in &mut fe {
+            if let Some((c, solved)) = est.remove(top) {
+                if !solved {
+                    interpolated.push(*top);
+                }
+                b.convergence = Some(c);
+            }
+            *secs += extra_secs.get(top).copied().unwrap_or(0.0);
+        }
+    }
     let wall_fe = t_phase.elapsed().as_secs_f64();
     for (top, b, mode, g, secs) in fe {
         if let Some(p) = per.get_mut(top) {
@@ -455,10 +549,20 @@ pub(crate) fn analyze_scheduled(
         let mut ok = smin >= sigma_min - stol && smax <= sigma_max + stol && running_lo <= lo_max;
         let (mut blf, mut modes, mut status, mut mechanism, mut nodes) =
             (None, Vec::new(), BucklingStatus::Skipped, None, 0);
+        let (mut blf_mesh, mut blf_error, mut blf_converged, mut blf_split) =
+            (None, None, None, None);
+        let mut blf_interpolated = None;
         if let Some(b) = &p.buckling {
             status = b.status;
             modes = b.factors.clone();
-            blf = b.factors.first().copied();
+            blf = b.blf();
+            if let Some(c) = &b.convergence {
+                blf_interpolated = Some(interpolated.contains(&q));
+                blf_mesh = b.factors.first().copied();
+                blf_error = Some(c.error);
+                blf_converged = Some(c.converged);
+                blf_split = c.levels.last().map(|l| l.split);
+            }
             mechanism = b.mechanism.clone();
             nodes = b.shell_nodes;
             let place = || match b.location {
@@ -518,6 +622,11 @@ pub(crate) fn analyze_scheduled(
             index: q,
             top_layer: p.top_layer,
             blf,
+            blf_mesh,
+            blf_error,
+            blf_converged,
+            blf_split,
+            blf_interpolated,
             blf_modes: modes,
             buckling: status,
             max_compression_stress_pa: smin,

@@ -30,6 +30,7 @@
 
 pub mod buckling;
 pub mod check;
+pub mod convergence;
 pub mod graded;
 pub mod green;
 pub mod reliability;
