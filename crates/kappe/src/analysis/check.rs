@@ -455,9 +455,12 @@ pub(crate) fn analyze_scheduled(
                     .collect::<Vec<_>>(),
             )
         };
-        let sampled = super::convergence::sample(&coarse, options.blf_tolerance, &mut |b| {
-            solve(b, &split_opts)
-        })?;
+        let sampled = super::convergence::sample(
+            &coarse,
+            options.blf_tolerance,
+            options.blf_sampling,
+            &mut |b| solve(b, &split_opts),
+        )?;
         let mut est: std::collections::BTreeMap<usize, (kappe_fe::ConvergedFactor, bool)> =
             sampled.into_iter().map(|(i, c, s)| (i, (c, s))).collect();
         // The states that could govern: solved, and converged to the tolerance.

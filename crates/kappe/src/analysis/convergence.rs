@@ -42,10 +42,11 @@ pub const SAMPLE_STRIDE: usize = 32;
 /// state index, its print-layer mesh factor). `solve(batch)` solves the split mesh of every
 /// state in `batch` (in parallel) and returns, per state, its converged estimate (levels 1×1
 /// and 2×2). Returns a converged estimate for every state of `coarse`, and whether it was
-/// solved (`true`) or interpolated.
+/// solved (`true`) or interpolated. `sampling` false: every state is solved.
 pub fn sample<E>(
     coarse: &[(usize, f64)],
     tolerance: f64,
+    sampling: bool,
     solve: &mut dyn FnMut(&[usize]) -> Result<Vec<(usize, ConvergedFactor)>, E>,
 ) -> Result<Vec<(usize, ConvergedFactor, bool)>, E> {
     let n = coarse.len();
@@ -79,7 +80,9 @@ pub fn sample<E>(
     if n == 0 {
         return Ok(Vec::new());
     }
-    let mut first: Vec<usize> = (0..n).step_by(SAMPLE_STRIDE).collect();
+    // Without sampling every state is a sample.
+    let stride = if sampling { SAMPLE_STRIDE } else { 1 };
+    let mut first: Vec<usize> = (0..n).step_by(stride).collect();
     first.push(n - 1);
     first.dedup();
     run(first.clone(), &mut solved)?;
@@ -246,7 +249,7 @@ mod tests {
             calls += batch.len();
             Ok(batch.iter().map(|&i| (i, exact(coarse[i].1, ratio(i)))).collect())
         };
-        let out = sample(&coarse, 0.005, &mut solve).unwrap();
+        let out = sample(&coarse, 0.005, true, &mut solve).unwrap();
         assert_eq!(out.len(), n);
         assert!(calls < n / 2, "{calls} solves");
         for (i, c, solved) in &out {

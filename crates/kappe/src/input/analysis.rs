@@ -195,6 +195,11 @@ pub struct AnalysisOptions {
     /// Largest number of splits per edge of the print-layer mesh (a power of two, 2…16).
     #[serde(default = "default_blf_max_split")]
     pub blf_max_split: usize,
+    /// Solve the 2×2 split on an adaptive sample of the states and interpolate the mesh
+    /// correction of the others (`crate::analysis::convergence`; the states that could govern
+    /// are always solved). `false`: the split is solved in every state.
+    #[serde(default = "default_true")]
+    pub blf_sampling: bool,
 }
 
 impl Default for AnalysisOptions {
@@ -211,6 +216,7 @@ impl Default for AnalysisOptions {
             converged_blf: true,
             blf_tolerance: DEFAULT_BLF_TOLERANCE,
             blf_max_split: default_blf_max_split(),
+            blf_sampling: true,
         }
     }
 }
