@@ -48,6 +48,7 @@
 pub mod assembly;
 pub mod ccx;
 pub mod clock;
+pub mod convergence;
 pub mod element;
 pub mod error;
 mod factor;
@@ -56,9 +57,11 @@ pub mod mesh_json;
 pub mod model;
 pub mod nonlinear;
 pub mod oracle;
+pub mod refine;
 mod solver;
 pub mod summary;
 
+pub use convergence::{ConvergedFactor, MeshLevel, converge_factor};
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use nonlinear::{

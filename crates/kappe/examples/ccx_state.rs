@@ -5,7 +5,9 @@
 //! (mid-side nodes of supported edges pinned too) and self-weight, against Kappe's CST+DKT and
 //! ANDES+DKMT on the same mesh.
 //!
-//! `cargo run --release -p kappe --example ccx_state -- STATE [STATE …]`
+//! `cargo run --release -p kappe --example ccx_state -- STATE [STATE …]`; `SPLIT=n` in the
+//! environment meshes the state's shell split n×n (`kappe_fe::refine::split`, the same flat
+//! facets) for both codes (docs/convergence.md records the numbers).
 //! (`KAPPE_DESIGN=file.toml` checks that design instead of the default, e.g. a corrugated cap).
 
 use std::collections::HashMap;
@@ -87,8 +89,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             design.print.start_arch_fraction,
             top,
         )?;
-        let shell = state_shell(&state, &state_material(&cap, &options, top).unwrap(), 1)
+        let mut shell = state_shell(&state, &state_material(&cap, &options, top).unwrap(), 1)
             .map_err(|e| format!("{e:?}"))?;
+        let n_split: usize = std::env::var("SPLIT")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
+        shell.model = kappe_fe::refine::split(&shell.model, n_split).model;
         let mut l = [0.0; 2];
         for (k, el) in [ElementKind::CstDkt, ElementKind::AndesDkmt]
             .into_iter()

@@ -8,8 +8,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_mode,
-    state_buckling_warm, state_material_with,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm,
+    state_material_with,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -30,8 +30,29 @@ pub struct StateAnalysis {
     pub index: usize,
     /// Id of the top layer.
     pub top_layer: i32,
-    /// Lowest positive buckling factor (None: not analysed, no shell or mechanism).
+    /// Lowest positive buckling factor (None: not analysed, no shell or mechanism): the
+    /// converged estimate when `AnalysisOptions::converged_blf` (the safe end of its bracket,
+    /// docs/convergence.md), else the shell mesh's own factor.
     pub blf: Option<f64>,
+    /// The print-layer shell mesh's own factor (the `blf` of Kappe before issue 23), when the
+    /// mesh error is controlled.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_mesh: Option<f64>,
+    /// Relative error estimate of `blf`: the converged factor lies in
+    /// [blf, blf·(1 + blf_error)] (docs/convergence.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_error: Option<f64>,
+    /// `blf_error ≤ AnalysisOptions::blf_tolerance`. A state left unconverged cannot govern:
+    /// its safe-side factor is above the governing state's converged bracket.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_converged: Option<bool>,
+    /// Splits per edge of the finest mesh solved (2: the print-layer mesh and its 2×2 split).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_split: Option<usize>,
+    /// The split mesh was not solved in this state: its correction is interpolated between
+    /// solved neighbours (`crate::analysis::convergence`; such a state cannot govern).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_interpolated: Option<bool>,
     /// All factors found (ascending).
     pub blf_modes: Vec<f64>,
     /// What the buckling analysis did.
@@ -284,15 +305,13 @@ pub fn fe_runs(options: &AnalysisOptions, total: usize) -> Vec<Vec<usize>> {
         }
     }
     let order: Vec<usize> = (0..total).filter(|&i| selected[i]).collect();
-    if options.grading.is_some() {
-        order
-            .chunks(WARM_RUN)
-            .rev()
-            .map(<[usize]>::to_vec)
-            .collect()
-    } else {
-        order.iter().rev().map(|&i| vec![i]).collect()
-    }
+    // Each state's eigensolve starts from the previous state's mode (graded or full mesh: the
+    // mode guess is keyed by layer and position in the layer).
+    order
+        .chunks(WARM_RUN)
+        .rev()
+        .map(<[usize]>::to_vec)
+        .collect()
 }
 
 /// The finite-element analysis of state `top` (shell buckling, and the green-state strength
@@ -303,6 +322,23 @@ pub fn fe_runs(options: &AnalysisOptions, total: usize) -> Vec<Vec<usize>> {
 /// # Errors
 /// A state that cannot be built or solved.
 pub fn state_fe(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    guess: &mut Option<ModeGuess>,
+) -> Result<StateFe, DesignError> {
+    // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
+    // all states together ([`converge_fe`]).
+    let first = AnalysisOptions {
+        blf_max_split: 1,
+        ..options.clone()
+    };
+    state_fe_with(cap, &first, green, top, guess)
+}
+
+/// [`state_fe`] with the options as given (`blf_max_split` > 1: the split meshes too).
+fn state_fe_with(
     cap: &Cap,
     options: &AnalysisOptions,
     green: Option<&crate::analysis::green::CapGreen>,
@@ -321,13 +357,9 @@ pub fn state_fe(
     };
     let (buckling, mode, green) = match checked {
         Some(c) => c,
-        _ if options.grading.is_some() => {
+        _ => {
             let (b, mode, next) = state_buckling_warm(&state, &mat, options, guess.as_ref())?;
             *guess = Some(next);
-            (b, mode, None)
-        }
-        _ => {
-            let (b, mode) = state_buckling_mode(&state, &mat, options)?;
             (b, mode, None)
         }
     };
@@ -338,6 +370,116 @@ pub fn state_fe(
         green,
         seconds: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// The mesh error of the buckling factors (issue 23, docs/convergence.md): the first-pass
+/// results `fe` ([`state_fe`]) gain each state's converged estimate — the 2×2 split solved on
+/// an adaptive sample of the states and the correction interpolated for the others
+/// ([`super::convergence::sample`]); the states that could govern are always solved, and
+/// refined further up to `blf_max_split` until within `blf_tolerance`. `solve(states, options)`
+/// solves single states (in parallel natively, in turn in the browser). Returns the states whose
+/// correction is interpolated. Nothing is done without `converged_blf`.
+///
+/// # Errors
+/// A state that cannot be built or solved.
+pub fn converge_fe(
+    options: &AnalysisOptions,
+    fe: &mut [StateFe],
+    solve: &mut dyn FnMut(&[usize], &AnalysisOptions) -> Result<Vec<StateFe>, DesignError>,
+) -> Result<Vec<usize>, DesignError> {
+    let mut interpolated: Vec<usize> = Vec::new();
+    if !options.converged_blf {
+        return Ok(interpolated);
+    }
+    let split_opts = AnalysisOptions {
+        blf_max_split: 2,
+        ..options.clone()
+    };
+    let mut coarse: Vec<(usize, f64)> = fe
+        .iter()
+        .filter(|f| f.buckling.status == BucklingStatus::Analysed)
+        .filter_map(|f| Some((f.state, *f.buckling.factors.first()?)))
+        .collect();
+    // In print order: the runs come back largest first.
+    coarse.sort_unstable_by_key(|c| c.0);
+    let mut extra_secs: std::collections::HashMap<usize, f64> = Default::default();
+    let mut solve_conv = |batch: &[usize], opts: &AnalysisOptions| {
+        let r = solve(batch, opts)?;
+        Ok::<_, DesignError>(
+            r.into_iter()
+                .filter_map(|f| {
+                    *extra_secs.entry(f.state).or_default() += f.seconds;
+                    Some((f.state, f.buckling.convergence?))
+                })
+                .collect::<Vec<_>>(),
+        )
+    };
+    let sampled = super::convergence::sample(
+        &coarse,
+        options.blf_tolerance,
+        options.blf_sampling,
+        &mut |b| solve_conv(b, &split_opts),
+    )?;
+    let mut est: std::collections::BTreeMap<usize, (kappe_fe::ConvergedFactor, bool)> =
+        sampled.into_iter().map(|(i, c, s)| (i, (c, s))).collect();
+    // The states that could govern: solved, and converged to the tolerance.
+    for _ in 0..4 {
+        let upper = est
+            .values()
+            .map(|(c, _)| c.upper)
+            .fold(f64::INFINITY, f64::min);
+        let interp: Vec<usize> = est
+            .iter()
+            .filter(|(_, (c, s))| !*s && c.extrapolated <= upper)
+            .map(|(i, _)| *i)
+            .collect();
+        let coarse_only: Vec<usize> = est
+            .iter()
+            .filter(|(_, (c, s))| {
+                *s && !c.converged
+                    && c.extrapolated <= upper
+                    && options.blf_max_split > 2
+                    && c.levels.last().is_some_and(|l| l.split < options.blf_max_split)
+            })
+            .map(|(i, _)| *i)
+            .collect();
+        if interp.is_empty() && coarse_only.is_empty() {
+            break;
+        }
+        for (i, c) in solve_conv(&interp, &split_opts)? {
+            est.insert(i, (c, true));
+        }
+        for (i, c) in solve_conv(&coarse_only, options)? {
+            est.insert(i, (c, true));
+        }
+    }
+    for f in fe.iter_mut() {
+        if let Some((c, solved)) = est.remove(&f.state) {
+            if !solved {
+                interpolated.push(f.state);
+            }
+            f.buckling.convergence = Some(c);
+        }
+        f.seconds += extra_secs.get(&f.state).copied().unwrap_or(0.0);
+    }
+    Ok(interpolated)
+}
+
+/// Single states solved with `options` in turn, each from a cold start (the convergence pass's
+/// solver in the browser, where there are no threads; natively they run in parallel).
+///
+/// # Errors
+/// A state that cannot be built or solved.
+pub fn solve_states(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    states: &[usize],
+) -> Result<Vec<StateFe>, DesignError> {
+    states
+        .iter()
+        .map(|&top| state_fe_with(cap, options, green, top, &mut None))
+        .collect()
 }
 
 /// [`analyze`] with the finite-element results of the selected states computed elsewhere
@@ -357,11 +499,16 @@ pub fn analyze_given(
     options.validate()?;
     let green = analysis_green(cap, schedule)?;
     let t_all = Instant::now();
+    let mut fe = fe;
+    let interpolated = converge_fe(options, &mut fe, &mut |states, opts| {
+        solve_states(cap, opts, green.as_ref(), states)
+    })?;
     assemble(
         cap,
         options,
         green,
         fe,
+        &interpolated,
         (t_all, 0.0),
         &AtomicBool::new(false),
     )
@@ -434,8 +581,18 @@ pub(crate) fn analyze_scheduled(
         .into_iter()
         .flatten()
         .collect();
+    let mut fe = fe;
+    let interpolated = converge_fe(options, &mut fe, &mut |states, opts| {
+        states
+            .par_iter()
+            .map(|&top| {
+                cancelled()?;
+                state_fe_with(cap, opts, green.as_ref(), top, &mut None)
+            })
+            .collect()
+    })?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
-    assemble(cap, options, green, fe, (t_all, wall_fe), stop)
+    assemble(cap, options, green, fe, &interpolated, (t_all, wall_fe), stop)
 }
 
 /// Phase 1 (every state's force pass and element stresses) and the report of [`analyze`], with
@@ -446,6 +603,7 @@ fn assemble(
     options: &AnalysisOptions,
     green: Option<crate::analysis::green::CapGreen>,
     fe: Vec<StateFe>,
+    interpolated: &[usize],
     (t_all, wall_fe): (Instant, f64),
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
@@ -571,10 +729,20 @@ fn assemble(
         let mut ok = smin >= sigma_min - stol && smax <= sigma_max + stol && running_lo <= lo_max;
         let (mut blf, mut modes, mut status, mut mechanism, mut nodes) =
             (None, Vec::new(), BucklingStatus::Skipped, None, 0);
+        let (mut blf_mesh, mut blf_error, mut blf_converged, mut blf_split) =
+            (None, None, None, None);
+        let mut blf_interpolated = None;
         if let Some(b) = &p.buckling {
             status = b.status;
             modes = b.factors.clone();
-            blf = b.factors.first().copied();
+            blf = b.blf();
+            if let Some(c) = &b.convergence {
+                blf_interpolated = Some(interpolated.contains(&q));
+                blf_mesh = b.factors.first().copied();
+                blf_error = Some(c.error);
+                blf_converged = Some(c.converged);
+                blf_split = c.levels.last().map(|l| l.split);
+            }
             mechanism = b.mechanism.clone();
             nodes = b.shell_nodes;
             let place = || match b.location {
@@ -634,6 +802,11 @@ fn assemble(
             index: q,
             top_layer: p.top_layer,
             blf,
+            blf_mesh,
+            blf_error,
+            blf_converged,
+            blf_split,
+            blf_interpolated,
             blf_modes: modes,
             buckling: status,
             max_compression_stress_pa: smin,

@@ -31,6 +31,7 @@
 pub mod buckling;
 pub mod check;
 pub mod collapse;
+pub mod convergence;
 pub mod graded;
 pub mod green;
 pub mod reliability;

@@ -168,8 +168,24 @@ pub struct StateEntry {
     pub base_reaction_n: [f64; 3],
     /// H/V ratio at the column ends.
     pub column_end_hv_ratio: f64,
-    /// Lowest positive buckling factor (null: not analysed, no shell, or a mechanism).
+    /// Lowest positive buckling factor (null: not analysed, no shell, or a mechanism): the
+    /// converged estimate when the mesh error is controlled (docs/convergence.md).
     pub blf: Option<f64>,
+    /// The print-layer shell mesh's own factor (with the mesh error controlled).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_mesh: Option<f64>,
+    /// Relative error estimate of `blf`: the converged factor lies in [blf, blf·(1 + blf_error)].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_error: Option<f64>,
+    /// `blf_error` within `analysis.blf_tolerance` (a state left unconverged cannot govern).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_converged: Option<bool>,
+    /// Splits per edge of the finest mesh solved.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_split: Option<usize>,
+    /// The split mesh's correction was interpolated between solved neighbouring states.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_interpolated: Option<bool>,
     /// What the buckling analysis did (absent without an analysis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub buckling: Option<BucklingStatus>,
@@ -430,6 +446,11 @@ impl Outcome {
                     base_reaction_n: s.forces.base_reaction,
                     column_end_hv_ratio: s.forces.column_end_hv_ratio,
                     blf: a.and_then(|a| a.blf),
+                    blf_mesh: a.and_then(|a| a.blf_mesh),
+                    blf_error: a.and_then(|a| a.blf_error),
+                    blf_converged: a.and_then(|a| a.blf_converged),
+                    blf_split: a.and_then(|a| a.blf_split),
+                    blf_interpolated: a.and_then(|a| a.blf_interpolated),
                     buckling: a.map(|a| a.buckling),
                     max_overhang_m: a.map(|a| a.max_overhang_m),
                     strength_utilisation: a.and_then(|a| a.strength_utilisation),

@@ -3,6 +3,7 @@
 mod analysis;
 mod analysis_loop;
 mod analysis_props;
+mod blf_convergence;
 mod cap;
 mod ceiling;
 mod collapse;

@@ -1,0 +1,99 @@
+//! The converged buckling factor (issue 23, docs/convergence.md): a cheap sample of
+//! `examples/blf_convergence.rs`.
+
+use kappe::analysis::shell::state_shell;
+use kappe::analysis::{AnalysisOptions, analyze, state_material};
+use kappe::form::states::build_state;
+use kappe_fe::BucklingOptions;
+
+/// Factors of a state of `d` on its print-layer mesh split 1, 2 and 4 times per edge.
+fn splits(d: &kappe::Design, top: usize) -> [f64; 3] {
+    let cap = kappe::design_cap(d, &|_| {}).unwrap();
+    let o = AnalysisOptions::default();
+    let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();
+    let shell = state_shell(&state, &state_material(&cap, &o, top).unwrap(), 1).unwrap();
+    let opts = BucklingOptions {
+        modes: 1,
+        tolerance: 1e-8,
+        sturm_check: false,
+        ..Default::default()
+    };
+    std::array::from_fn(|k| {
+        let m = kappe_fe::refine::split(&shell.model, 1 << k).model;
+        kappe_fe::buckling(&m, &opts).unwrap().factors[0]
+    })
+}
+
+/// State 10 of the default cap (a narrow strip of the start section, the print-layer mesh 3.5 %
+/// high): Kappe's estimate from splits 1 and 2 is within the tolerance of the 4×4 reference,
+/// never above it by more, and below its own upper bracket end.
+#[test]
+fn the_converged_factor_of_an_early_state_is_within_the_tolerance() {
+    let d = kappe::Design::default();
+    let [l1, l2, l4] = splits(&d, 10);
+    // Monotone refinement (what the order-1 extrapolation relies on).
+    assert!(l1 > l2 && l2 > l4, "{l1} {l2} {l4}");
+    // The reference: splits 2 and 4 at the observed order (clamped to [1, 2]).
+    let p = ((l1 - l2) / (l2 - l4)).log2().clamp(1.0, 2.0);
+    let reference = l4 - (l2 - l4) / (2f64.powf(p) - 1.0);
+    let est = kappe_fe::ConvergedFactor::from_pair(
+        [(1, l1), (2, l2)]
+            .map(|(split, factor)| kappe_fe::MeshLevel {
+                split,
+                factor,
+                n_free_dofs: 0,
+                steps: 0,
+            })
+            .to_vec(),
+        0.005,
+    )
+    .unwrap();
+    let tol = AnalysisOptions::default().blf_tolerance;
+    assert!(l1 / reference - 1.0 > 0.02, "the layer mesh alone is > 2 % high");
+    assert!(
+        (est.extrapolated / reference - 1.0).abs() <= tol,
+        "{} vs {reference}",
+        est.extrapolated
+    );
+    assert!(est.upper >= reference * (1.0 - tol));
+}
+
+/// A short cap analysed as `kappe design` does (the split on an adaptive sample of states) and
+/// with the split solved in every state: every state's factor agrees within the tolerance, the
+/// governing state is the same and is solved, not interpolated, and converged.
+#[test]
+fn sampled_states_match_every_state_solved() {
+    let d = kappe::Design::from_toml_str("[cap]\nlength = 0.3\n").unwrap();
+    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
+    let sampled = analyze(&cap, &AnalysisOptions::default(), &|_| {}).unwrap();
+    let all = analyze(
+        &cap,
+        &AnalysisOptions {
+            blf_sampling: false,
+            ..Default::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let tol = AnalysisOptions::default().blf_tolerance;
+    let gov = |a: &kappe::analysis::Analysis| {
+        a.states
+            .iter()
+            .filter_map(|s| Some((s.index, s.blf?)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap()
+    };
+    assert_eq!(gov(&sampled).0, gov(&all).0);
+    let g = &sampled.states[gov(&sampled).0];
+    assert_eq!(g.blf_interpolated, Some(false));
+    assert!(g.blf_converged.unwrap());
+    assert!(g.blf.unwrap() < g.blf_mesh.unwrap());
+    let mut interpolated = 0;
+    for (a, b) in sampled.states.iter().zip(&all.states) {
+        if let (Some(x), Some(y)) = (a.blf, b.blf) {
+            assert!((x / y - 1.0).abs() <= tol, "state {}: {x} vs {y}", a.index);
+            interpolated += usize::from(a.blf_interpolated == Some(true));
+        }
+    }
+    assert!(interpolated > 0, "the sample interpolates some states");
+}
