@@ -8,8 +8,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm,
-    state_material_with,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm, state_material_with,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -465,7 +464,10 @@ pub(crate) fn analyze_scheduled(
             sampled.into_iter().map(|(i, c, s)| (i, (c, s))).collect();
         // The states that could govern: solved, and converged to the tolerance.
         for _ in 0..4 {
-            let upper = est.values().map(|(c, _)| c.upper).fold(f64::INFINITY, f64::min);
+            let upper = est
+                .values()
+                .map(|(c, _)| c.upper)
+                .fold(f64::INFINITY, f64::min);
             let interp: Vec<usize> = est
                 .iter()
                 .filter(|(_, (c, s))| !*s && c.extrapolated <= upper)
@@ -474,8 +476,12 @@ pub(crate) fn analyze_scheduled(
             let coarse_only: Vec<usize> = est
                 .iter()
                 .filter(|(_, (c, s))| {
-                    *s && !c.converged && c.extrapolated <= upper && options.blf_max_split > 2
-                        && c.levels.last().is_some_and(|l| l.split < options.blf_max_split)
+                    *s && !c.converged
+                        && c.extrapolated <= upper
+                        && options.blf_max_split > 2
+                        && c.levels
+                            .last()
+                            .is_some_and(|l| l.split < options.blf_max_split)
                 })
                 .map(|(i, _)| *i)
                 .collect();
