@@ -145,6 +145,9 @@ impl From<FeWire> for StateFe {
                 location: w.location,
                 mechanism: w.mechanism,
                 shell_nodes: w.shell_nodes,
+                // A worker's result is the first pass (`state_fe`): the mesh error is estimated
+                // afterwards over all states (`converge_fe`, in `analyze_given`).
+                convergence: None,
             },
             // The mode shape is not drawn by the designer (it is large); it enters no check.
             mode: Vec::new(),

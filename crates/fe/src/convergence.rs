@@ -65,7 +65,15 @@ impl ConvergedFactor {
         let (lo, hi, error) = if step >= 0.0 {
             let lo = f - step;
             let hi = f - step / 3.0;
-            (lo, hi, if lo > 0.0 { (hi - lo) / lo } else { f64::INFINITY })
+            (
+                lo,
+                hi,
+                if lo > 0.0 {
+                    (hi - lo) / lo
+                } else {
+                    f64::INFINITY
+                },
+            )
         } else {
             // Not decreasing: no extrapolation; the finest value, the step as the error.
             (f, f, -step / f)
@@ -178,7 +186,9 @@ mod tests {
             ..Default::default()
         };
         let coarse = buckling(&m, &opts).unwrap();
-        let c = converge_factor(&m, &coarse, &opts, 1e-9, 2).unwrap().unwrap();
+        let c = converge_factor(&m, &coarse, &opts, 1e-9, 2)
+            .unwrap()
+            .unwrap();
         assert_eq!(c.levels.len(), 2);
         let reference = 0.068_970_4;
         let fine = c.levels[1].factor;

@@ -68,7 +68,10 @@ impl Symbolic {
     /// Symbolic Cholesky with an AMD ordering of the **node** graph (`dofs`: the free DOFs of a
     /// node are consecutive and ordered together): the same fill as AMD on the DOF graph to
     /// within its heuristics, found on a graph 36 times smaller (6 DOFs per node).
-    pub(crate) fn new_blocked(p: &Pattern, dofs: &crate::assembly::DofMap) -> Result<Self, FeError> {
+    pub(crate) fn new_blocked(
+        p: &Pattern,
+        dofs: &crate::assembly::DofMap,
+    ) -> Result<Self, FeError> {
         let n = p.n;
         let err = |detail: String| FeError::Numerical {
             stage: "symbolic Cholesky",

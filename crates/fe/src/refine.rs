@@ -32,7 +32,8 @@ pub fn split(model: &ShellModel, n: usize) -> Refined {
     let n = n.max(1);
     let n0 = model.nodes.len();
     let mut nodes = model.nodes.clone();
-    let mut parents: Vec<[(usize, f64); 3]> = (0..n0).map(|i| [(i, 1.0), (i, 0.0), (i, 0.0)]).collect();
+    let mut parents: Vec<[(usize, f64); 3]> =
+        (0..n0).map(|i| [(i, 1.0), (i, 0.0), (i, 0.0)]).collect();
     let fixed0 = model.fixed_mask();
     let mut fixed: Vec<[bool; 6]> = fixed0.clone();
     // Interior points of edge (a, b), a < b: n − 1 nodes from a to b.
@@ -84,7 +85,11 @@ pub fn split(model: &ShellModel, n: usize) -> Refined {
                     });
                     base + pos - 1
                 } else {
-                    let w = [k as f64 / n as f64, i as f64 / n as f64, j as f64 / n as f64];
+                    let w = [
+                        k as f64 / n as f64,
+                        i as f64 / n as f64,
+                        j as f64 / n as f64,
+                    ];
                     nodes.push(lerp(pa, pb, pc, w));
                     parents.push([(a, w[0]), (b, w[1]), (c, w[2])]);
                     fixed.push(std::array::from_fn(|d| {
@@ -132,31 +137,9 @@ pub fn split(model: &ShellModel, n: usize) -> Refined {
         .filter(|(_, f)| f.iter().any(|x| *x))
         .map(|(i, f)| Support { node: i, fixed: *f })
         .collect();
-    Refined { model: out, parents }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::generate::ss_plate;
-
-    #[test]
-    fn split_counts_and_area() {
-        let m = ss_plate(4);
-        for n in 1..=4 {
-            let r = split(&m, n);
-            assert_eq!(r.model.triangles.len(), m.triangles.len() * n * n);
-            // Euler: V = original + edges·(n−1) + faces·(n−1)(n−2)/2.
-            let mut e = std::collections::HashSet::new();
-            for t in &m.triangles {
-                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-                    e.insert((a.min(b), a.max(b)));
-                }
-            }
-            let expect = m.nodes.len() + e.len() * (n - 1) + m.triangles.len() * (n - 1) * n.saturating_sub(2) / 2;
-            assert_eq!(r.model.nodes.len(), expect, "n = {n}");
-            assert!(r.model.validate().is_ok());
-        }
+    Refined {
+        model: out,
+        parents,
     }
 }
 
@@ -168,7 +151,9 @@ mod tests {
 pub fn red_green(model: &ShellModel, marked: &[bool]) -> Refined {
     let key = |a: usize, b: usize| (a.min(b), a.max(b));
     let nt = model.triangles.len();
-    let mut red: Vec<bool> = (0..nt).map(|e| marked.get(e).copied().unwrap_or(false)).collect();
+    let mut red: Vec<bool> = (0..nt)
+        .map(|e| marked.get(e).copied().unwrap_or(false))
+        .collect();
     let mut cut: std::collections::HashSet<(usize, usize)> = std::collections::HashSet::new();
     let edges_of = |t: &[usize; 3]| [key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])];
     for (e, t) in model.triangles.iter().enumerate() {
@@ -194,8 +179,9 @@ pub fn red_green(model: &ShellModel, marked: &[bool]) -> Refined {
     }
     let fixed0 = model.fixed_mask();
     let mut nodes = model.nodes.clone();
-    let mut parents: Vec<[(usize, f64); 3]> =
-        (0..nodes.len()).map(|i| [(i, 1.0), (i, 0.0), (i, 0.0)]).collect();
+    let mut parents: Vec<[(usize, f64); 3]> = (0..nodes.len())
+        .map(|i| [(i, 1.0), (i, 0.0), (i, 0.0)])
+        .collect();
     let mut fixed = fixed0.clone();
     let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
     let mut cut_sorted: Vec<(usize, usize)> = cut.into_iter().collect();
@@ -251,7 +237,10 @@ pub fn red_green(model: &ShellModel, marked: &[bool]) -> Refined {
         .filter(|(_, f)| f.iter().any(|x| *x))
         .map(|(i, f)| Support { node: i, fixed: *f })
         .collect();
-    Refined { model: out, parents }
+    Refined {
+        model: out,
+        parents,
+    }
 }
 
 impl Refined {
@@ -275,5 +264,57 @@ impl Refined {
                 v
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::ss_plate;
+
+    #[test]
+    fn split_counts_and_area() {
+        let m = ss_plate(4);
+        for n in 1..=4 {
+            let r = split(&m, n);
+            assert_eq!(r.model.triangles.len(), m.triangles.len() * n * n);
+            // Euler: V = original + edges·(n−1) + faces·(n−1)(n−2)/2.
+            let mut e = std::collections::HashSet::new();
+            for t in &m.triangles {
+                for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                    e.insert((a.min(b), a.max(b)));
+                }
+            }
+            let expect = m.nodes.len()
+                + e.len() * (n - 1)
+                + m.triangles.len() * (n - 1) * n.saturating_sub(2) / 2;
+            assert_eq!(r.model.nodes.len(), expect, "n = {n}");
+            assert!(r.model.validate().is_ok());
+        }
+    }
+
+    #[test]
+    fn red_green_is_conforming() {
+        let m = ss_plate(4);
+        let mut marked = vec![false; m.triangles.len()];
+        marked[0] = true;
+        marked[5] = true;
+        let r = red_green(&m, &marked);
+        assert!(r.model.validate().is_ok());
+        // Every interior edge is shared by exactly two triangles (no hanging node).
+        let mut count = std::collections::HashMap::new();
+        for t in &r.model.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        assert!(count.values().all(|&c| c <= 2));
+        let area = |m: &ShellModel| -> f64 {
+            m.triangles
+                .iter()
+                .map(|t| crate::element::TriangleGeometry::new(&t.map(|n| m.nodes[n])).area)
+                .sum()
+        };
+        assert!((area(&r.model) - area(&m)).abs() < 1e-12);
     }
 }

@@ -25,13 +25,16 @@ fn design(length: f64) -> kappe::Design {
     d
 }
 
+/// Per mesh: splits per edge, factor, free DOFs, seconds.
+type Level = (usize, f64, usize, f64);
+
 /// The factors of `state` on splits 1, 2, 4, … ≤ `max_split`.
 fn splits(
     cap: &kappe::form::cap::Cap,
     d: &kappe::Design,
     top: usize,
     max_split: usize,
-) -> Result<Vec<(usize, f64, usize, f64)>, Box<dyn std::error::Error>> {
+) -> Result<Vec<Level>, Box<dyn std::error::Error>> {
     let options = AnalysisOptions::default();
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top)?;
     let shell = state_shell(&state, &state_material(cap, &options, top)?, 1)
@@ -71,19 +74,27 @@ fn splits(
 
 /// The reference from the finest levels: the last two extrapolated at the order observed on the
 /// last three (clamped to [1, 2]); with two levels, order 1.
-fn reference(levels: &[(usize, f64, usize, f64)]) -> (f64, f64) {
+fn reference(levels: &[Level]) -> (f64, f64) {
     let n = levels.len();
     let f = |i: usize| levels[i].1;
     let p = if n >= 3 {
         let r = (f(n - 3) - f(n - 2)) / (f(n - 2) - f(n - 1));
-        if r > 0.0 { r.log2().clamp(1.0, 2.0) } else { 1.0 }
+        if r > 0.0 {
+            r.log2().clamp(1.0, 2.0)
+        } else {
+            1.0
+        }
     } else {
         1.0
     };
     (f(n - 1) - (f(n - 2) - f(n - 1)) / (2f64.powf(p) - 1.0), p)
 }
 
-fn states(length: f64, max_split: usize, picks: &[usize]) -> Result<(), Box<dyn std::error::Error>> {
+fn states(
+    length: f64,
+    max_split: usize,
+    picks: &[usize],
+) -> Result<(), Box<dyn std::error::Error>> {
     let d = design(length);
     let cap = kappe::design_cap(&d, &|_| {})?;
     println!("cap length {length} m, {} states", cap.states.len());
@@ -188,7 +199,9 @@ fn table(length: f64, every: usize) -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .filter_map(|s| Some((s.blf_error?, s.index)))
         .max_by(|a, b| a.0.total_cmp(&b.0));
-    println!("split solved in {solved} states, the others interpolated; largest error estimate {worst_err:?}");
+    println!(
+        "split solved in {solved} states, the others interpolated; largest error estimate {worst_err:?}"
+    );
     if every == 0 {
         return Ok(());
     }
@@ -239,7 +252,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some("table") => table(num(1, 0.6), num(2, 0.0) as usize),
         _ => {
             let picks: Vec<usize> = args.iter().skip(3).filter_map(|a| a.parse().ok()).collect();
-            let picks = if picks.is_empty() { vec![10, 40, 112] } else { picks };
+            let picks = if picks.is_empty() {
+                vec![10, 40, 112]
+            } else {
+                picks
+            };
             states(num(1, 0.6), num(2, 4.0) as usize, &picks)
         }
     }

@@ -38,6 +38,9 @@ pub const SAMPLE_SHARE: f64 = 1.0 / 10.0;
 /// Initial spacing of the samples (states), before bisection.
 pub const SAMPLE_STRIDE: usize = 32;
 
+/// Solves the split mesh of a batch of states: (state, converged estimate) per state.
+pub type SplitSolve<'a, E> = dyn FnMut(&[usize]) -> Result<Vec<(usize, ConvergedFactor)>, E> + 'a;
+
 /// Adaptive sampling of the mesh-correction ratio over the states `coarse` (in print order:
 /// state index, its print-layer mesh factor). `solve(batch)` solves the split mesh of every
 /// state in `batch` (in parallel) and returns, per state, its converged estimate (levels 1×1
@@ -47,7 +50,7 @@ pub fn sample<E>(
     coarse: &[(usize, f64)],
     tolerance: f64,
     sampling: bool,
-    solve: &mut dyn FnMut(&[usize]) -> Result<Vec<(usize, ConvergedFactor)>, E>,
+    solve: &mut SplitSolve<'_, E>,
 ) -> Result<Vec<(usize, ConvergedFactor, bool)>, E> {
     let n = coarse.len();
     let mut solved: Vec<Option<ConvergedFactor>> = vec![None; n];
@@ -57,26 +60,25 @@ pub fn sample<E>(
         let l = &c.levels;
         l.get(1).map_or(1.0, |f| f.factor) / l[0].factor
     };
-    let mut run = |positions: Vec<usize>,
-                   solved: &mut Vec<Option<ConvergedFactor>>|
-     -> Result<(), E> {
-        let mut todo: Vec<usize> = positions
-            .into_iter()
-            .filter(|&p| solved[p].is_none())
-            .collect();
-        todo.sort_unstable();
-        todo.dedup();
-        if todo.is_empty() {
-            return Ok(());
-        }
-        let states: Vec<usize> = todo.iter().map(|&p| coarse[p].0).collect();
-        for (state, c) in solve(&states)? {
-            if let Some(p) = todo.iter().copied().find(|&p| coarse[p].0 == state) {
-                solved[p] = Some(c);
+    let mut run =
+        |positions: Vec<usize>, solved: &mut Vec<Option<ConvergedFactor>>| -> Result<(), E> {
+            let mut todo: Vec<usize> = positions
+                .into_iter()
+                .filter(|&p| solved[p].is_none())
+                .collect();
+            todo.sort_unstable();
+            todo.dedup();
+            if todo.is_empty() {
+                return Ok(());
             }
-        }
-        Ok(())
-    };
+            let states: Vec<usize> = todo.iter().map(|&p| coarse[p].0).collect();
+            for (state, c) in solve(&states)? {
+                if let Some(p) = todo.iter().copied().find(|&p| coarse[p].0 == state) {
+                    solved[p] = Some(c);
+                }
+            }
+            Ok(())
+        };
     if n == 0 {
         return Ok(Vec::new());
     }
@@ -247,7 +249,10 @@ mod tests {
         let mut calls = 0usize;
         let mut solve = |batch: &[usize]| -> Result<Vec<(usize, ConvergedFactor)>, ()> {
             calls += batch.len();
-            Ok(batch.iter().map(|&i| (i, exact(coarse[i].1, ratio(i)))).collect())
+            Ok(batch
+                .iter()
+                .map(|&i| (i, exact(coarse[i].1, ratio(i))))
+                .collect())
         };
         let out = sample(&coarse, 0.005, true, &mut solve).unwrap();
         assert_eq!(out.len(), n);

@@ -252,7 +252,9 @@ impl AnalysisOptions {
                 "allowed: 1 ≤ layers per mesh row ≤ 16",
             ));
         }
-        if !(self.blf_tolerance.is_finite() && self.blf_tolerance > 0.0 && self.blf_tolerance <= 0.1)
+        if !(self.blf_tolerance.is_finite()
+            && self.blf_tolerance > 0.0
+            && self.blf_tolerance <= 0.1)
         {
             return Err(bad(
                 "analysis.blf_tolerance",

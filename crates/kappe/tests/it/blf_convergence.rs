@@ -49,7 +49,10 @@ fn the_converged_factor_of_an_early_state_is_within_the_tolerance() {
     )
     .unwrap();
     let tol = AnalysisOptions::default().blf_tolerance;
-    assert!(l1 / reference - 1.0 > 0.02, "the layer mesh alone is > 2 % high");
+    assert!(
+        l1 / reference - 1.0 > 0.02,
+        "the layer mesh alone is > 2 % high"
+    );
     assert!(
         (est.extrapolated / reference - 1.0).abs() <= tol,
         "{} vs {reference}",
