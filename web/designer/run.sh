@@ -31,4 +31,4 @@ if [ "$SIZE" -gt 5000000 ]; then
   exit 1
 fi
 KAPPE_DESIGNER="$OUT/designer/designer.html" KAPPE_BIN="$BIN" node --test web/designer/designer.test.mjs
-node web/designer/bench.mjs "$OUT/designer/designer.html"
+KAPPE_BENCH_MOVES=${KAPPE_BENCH_MOVES:-3} node web/designer/bench.mjs "$OUT/designer/designer.html"

@@ -8,8 +8,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm,
-    state_material_with,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm, state_material_with,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -439,7 +438,9 @@ pub fn converge_fe(
                 *s && !c.converged
                     && c.extrapolated <= upper
                     && options.blf_max_split > 2
-                    && c.levels.last().is_some_and(|l| l.split < options.blf_max_split)
+                    && c.levels
+                        .last()
+                        .is_some_and(|l| l.split < options.blf_max_split)
             })
             .map(|(i, _)| *i)
             .collect();
@@ -500,9 +501,20 @@ pub fn analyze_given(
     let green = analysis_green(cap, schedule)?;
     let t_all = Instant::now();
     let mut fe = fe;
-    let interpolated = converge_fe(options, &mut fe, &mut |states, opts| {
-        solve_states(cap, opts, green.as_ref(), states)
-    })?;
+    // The mesh error is estimated over all states together, so only once every selected state
+    // is in: a partial verdict (the designer's, while its workers run) carries the first-pass
+    // factors.
+    let selected: usize = fe_runs(options, cap.states.len())
+        .iter()
+        .map(Vec::len)
+        .sum();
+    let interpolated = if fe.len() >= selected {
+        converge_fe(options, &mut fe, &mut |states, opts| {
+            solve_states(cap, opts, green.as_ref(), states)
+        })?
+    } else {
+        Vec::new()
+    };
     assemble(
         cap,
         options,
@@ -592,7 +604,15 @@ pub(crate) fn analyze_scheduled(
             .collect()
     })?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
-    assemble(cap, options, green, fe, &interpolated, (t_all, wall_fe), stop)
+    assemble(
+        cap,
+        options,
+        green,
+        fe,
+        &interpolated,
+        (t_all, wall_fe),
+        stop,
+    )
 }
 
 /// Phase 1 (every state's force pass and element stresses) and the report of [`analyze`], with
