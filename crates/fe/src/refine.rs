@@ -122,25 +122,17 @@ pub fn split(model: &ShellModel, n: usize) -> Refined {
             materials.extend(std::iter::repeat_n(model.materials[e], added));
         }
     }
-    let mut out = model.clone();
-    out.nodes = nodes;
-    out.triangles = triangles;
-    if per_element_t {
-        out.thickness = thickness;
-    }
-    if per_element_m {
-        out.materials = materials;
-    }
-    out.supports = fixed
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.iter().any(|x| *x))
-        .map(|(i, f)| Support { node: i, fixed: *f })
-        .collect();
-    Refined {
-        model: out,
+    assemble(
+        model,
+        nodes,
+        triangles,
+        (
+            per_element_t.then_some(thickness),
+            per_element_m.then_some(materials),
+        ),
+        &fixed,
         parents,
-    }
+    )
 }
 
 /// One level of conforming **red–green** refinement: every `marked` triangle (and every
@@ -222,25 +214,17 @@ pub fn red_green(model: &ShellModel, marked: &[bool]) -> Refined {
             materials.extend(std::iter::repeat_n(model.materials[e], added));
         }
     }
-    let mut out = model.clone();
-    out.nodes = nodes;
-    out.triangles = triangles;
-    if per_element_t {
-        out.thickness = thickness;
-    }
-    if per_element_m {
-        out.materials = materials;
-    }
-    out.supports = fixed
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.iter().any(|x| *x))
-        .map(|(i, f)| Support { node: i, fixed: *f })
-        .collect();
-    Refined {
-        model: out,
+    assemble(
+        model,
+        nodes,
+        triangles,
+        (
+            per_element_t.then_some(thickness),
+            per_element_m.then_some(materials),
+        ),
+        &fixed,
         parents,
-    }
+    )
 }
 
 impl Refined {
@@ -264,6 +248,38 @@ impl Refined {
                 v
             })
             .collect()
+    }
+}
+
+/// The refined model from its parts: `model`'s data with the new nodes and triangles, the
+/// per-element thickness and materials where `model` has them per element, and a support on
+/// every node with a fixed DOF.
+fn assemble(
+    model: &ShellModel,
+    nodes: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+    (thickness, materials): (Option<Vec<f64>>, Option<Vec<crate::model::Material>>),
+    fixed: &[[bool; 6]],
+    parents: Vec<[(usize, f64); 3]>,
+) -> Refined {
+    let mut out = model.clone();
+    out.nodes = nodes;
+    out.triangles = triangles;
+    if let Some(t) = thickness {
+        out.thickness = t;
+    }
+    if let Some(m) = materials {
+        out.materials = m;
+    }
+    out.supports = fixed
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.iter().any(|x| *x))
+        .map(|(i, f)| Support { node: i, fixed: *f })
+        .collect();
+    Refined {
+        model: out,
+        parents,
     }
 }
 
