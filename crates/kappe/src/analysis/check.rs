@@ -371,6 +371,10 @@ fn state_fe_with(
     })
 }
 
+/// A solver of single states with given options (see [`converge_fe`]).
+pub type SolveStates<'a> =
+    dyn FnMut(&[usize], &AnalysisOptions) -> Result<Vec<StateFe>, DesignError> + 'a;
+
 /// The mesh error of the buckling factors (issue 23, docs/convergence.md): the first-pass
 /// results `fe` ([`state_fe`]) gain each state's converged estimate — the 2×2 split solved on
 /// an adaptive sample of the states and the correction interpolated for the others
@@ -384,7 +388,7 @@ fn state_fe_with(
 pub fn converge_fe(
     options: &AnalysisOptions,
     fe: &mut [StateFe],
-    solve: &mut dyn FnMut(&[usize], &AnalysisOptions) -> Result<Vec<StateFe>, DesignError>,
+    solve: &mut SolveStates<'_>,
 ) -> Result<Vec<usize>, DesignError> {
     let mut interpolated: Vec<usize> = Vec::new();
     if !options.converged_blf {
