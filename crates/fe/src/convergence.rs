@@ -16,7 +16,7 @@
 //! converged factor lies in [λ̂₁, λ̂₂] for 1 ≤ p ≤ 2: the reported factor is λ̂₁, and its error
 //! estimate `(λ̂₂ − λ̂₁)/λ̂₁ = ⅔ (λ_c − λ_f)/λ̂₁` bounds how far below the converged value it can
 //! be. A level that does not decrease (λ_f > λ_c: out of the asymptotic range, or a mode switch)
-//! is reported with its finest value and the step as its error, never extrapolated upwards.
+//! is reported with the lower (coarse) value and the step as its error, never extrapolated upwards.
 //!
 //! Hand-written: a loop over [`crate::buckling`] on [`crate::refine::split`] meshes.
 
@@ -75,8 +75,10 @@ impl ConvergedFactor {
                 },
             )
         } else {
-            // Not decreasing: no extrapolation; the finest value, the step as the error.
-            (f, f, -step / f)
+            // Not decreasing (out of the asymptotic range, e.g. a graded mesh's coarse rows, or
+            // a mode switch): no extrapolation; the lower value (the coarse one), the step as
+            // the error.
+            (c, f, -step / c)
         };
         Some(Self {
             levels,
@@ -169,9 +171,10 @@ mod tests {
         assert!(e.extrapolated < 1.0 && e.upper >= 1.0 - 1e-12);
         assert!(1.0 / e.extrapolated - 1.0 <= e.error + 1e-12);
         assert!(!e.converged);
-        // Increasing: never extrapolated upwards.
+        // Increasing: never extrapolated upwards, the lower value reported.
         let e = ConvergedFactor::from_pair(vec![level(1, 1.0), level(2, 1.01)], 0.05).unwrap();
-        assert_eq!(e.extrapolated, 1.01);
+        assert_eq!(e.extrapolated, 1.0);
+        assert!((e.error - 0.01).abs() < 1e-12);
     }
 
     #[test]

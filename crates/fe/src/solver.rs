@@ -235,7 +235,7 @@ impl BucklingSolver {
             return Err(FeError::NoFreeDofs);
         }
         let pattern = Pattern::new(model, &dofs);
-        let symbolic = Symbolic::new_blocked(&pattern, &dofs)?;
+        let symbolic = Symbolic::new(&pattern)?;
         Ok(Self {
             triangles: model.triangles.clone(),
             fixed: model.fixed_mask(),

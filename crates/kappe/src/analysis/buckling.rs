@@ -112,12 +112,20 @@ pub fn state_buckling(
 }
 
 /// [`state_buckling`] and its first mode shape.
+///
+/// With `converged_blf` the converged estimate ([`StateBuckling::blf`]) stops at the 2×2 split
+/// here: only [`crate::analysis::analyze`] refines further, and only the states that could
+/// govern (docs/convergence.md).
 pub fn state_buckling_mode(
     state: &State,
     material: &ShellMaterial,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode), DesignError> {
-    state_buckling_warm(state, material, options, None).map(|(b, m, _)| (b, m))
+    let options = AnalysisOptions {
+        blf_max_split: options.blf_max_split.min(2),
+        ..options.clone()
+    };
+    state_buckling_warm(state, material, &options, None).map(|(b, m, _)| (b, m))
 }
 
 /// Mode 1 of a state per shell node, keyed by (layer id, index of the node in its layer): keys
