@@ -42,20 +42,47 @@ fn session_with_worker_results_equals_run() {
     let outcome = kappe::run(&design, &options, &kappe::no_progress).expect("run");
     let analysis = outcome.analysis.as_ref().expect("analysis");
     assert_eq!(report["ok"], json!(outcome.verdict.ok));
-    assert_eq!(report["min_blf"], json!(outcome.min_blf()));
+    let (page_min, native_min) = (report["min_blf"].as_f64(), outcome.min_blf());
+    match (page_min, native_min) {
+        (Some(a), Some(b)) => assert!((a - b).abs() <= 1e-9 * b.abs(), "{a} vs {b}"),
+        (a, b) => assert_eq!(a, b),
+    }
     let states = report["states"].as_array().expect("states");
     assert_eq!(states.len(), analysis.states.len());
+    // Every BLF within 1e-9 relative: the mesh-error pass solves its states on the calling
+    // thread here (faer may fork there) and inside rayon workers natively (faer sequential), so
+    // the factorizations sum in a different order (~1e-14 observed); the bound is 1e-6.
     for (page, native) in states.iter().zip(&analysis.states) {
-        assert_eq!(page["blf"], json!(native.blf), "state {}", native.index);
+        match (page["blf"].as_f64(), native.blf) {
+            (Some(a), Some(b)) => assert!(
+                (a - b).abs() <= 1e-9 * b.abs(),
+                "state {}: {a} vs {b}",
+                native.index
+            ),
+            (a, b) => assert_eq!(a, b, "state {}", native.index),
+        }
         assert_eq!(
             page["compression_pa"],
             json!(native.max_compression_stress_pa)
         );
     }
-    assert_eq!(
-        report["constraints"],
-        serde_json::to_value(&analysis.constraints).expect("json")
-    );
+    // The constraint table: the same rows, verdicts and governing states; the worst values to
+    // the BLFs' 1e-9 (above).
+    let rows = report["constraints"].as_array().expect("constraints");
+    assert_eq!(rows.len(), analysis.constraints.len());
+    for (page, native) in rows.iter().zip(&analysis.constraints) {
+        assert_eq!(page["name"], json!(native.name));
+        assert_eq!(page["pass"], json!(native.pass), "{}", native.name);
+        assert_eq!(page["state"], json!(native.state), "{}", native.name);
+        match (page["worst"].as_f64(), native.worst) {
+            (Some(a), Some(b)) => assert!(
+                (a - b).abs() <= 1e-9 * b.abs().max(1e-300),
+                "{}: {a} vs {b}",
+                native.name
+            ),
+            (a, b) => assert_eq!(a, b, "{}", native.name),
+        }
+    }
 }
 
 #[test]
