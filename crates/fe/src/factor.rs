@@ -32,20 +32,12 @@ pub(crate) enum LltFailure {
     Other(FeError),
 }
 
-/// faer's parallelism: the rayon pool, except inside a rayon worker (e.g. the print states
-/// analysed in parallel), where nested fork–join on small triangular solves costs more than it
-/// saves: there each factorization runs on its own thread. Sequential on wasm32 (the designer in
-/// the browser runs one state per Web Worker, and faer's rayon feature does not build there).
-#[cfg(not(target_arch = "wasm32"))]
-fn par() -> Par {
-    if rayon::current_thread_index().is_some() {
-        Par::Seq
-    } else {
-        Par::rayon(0)
-    }
-}
-
-#[cfg(target_arch = "wasm32")]
+/// faer's parallelism: always sequential. A factorization's floating-point sums then come out
+/// in one order whichever thread runs it, so the CLI, Python, a Dask worker and the browser
+/// compute bit-identical factors (a parallel factorization on a calling thread summed
+/// differently from the sequential one inside rayon workers: a study row differed in its last
+/// digit between Dask and the CLI). Parallelism comes from the print states solved side by side;
+/// nested fork–join on small triangular solves cost more than it saved there anyway.
 fn par() -> Par {
     Par::Seq
 }
