@@ -107,6 +107,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         t.elapsed().as_secs_f64()
     );
+    let t = Instant::now();
+    let margins = kappe_robot::tolerance::station_margins(
+        &plan,
+        &kappe_robot::tolerance::BaseTolerance::default(),
+    );
+    let text: Vec<String> = margins
+        .iter()
+        .map(|m| {
+            format!(
+                "station {}: {}±{:.1} mm, ±{:.2}°",
+                m.station,
+                if m.at_least { "≥ " } else { "" },
+                m.position_m * 1e3,
+                m.yaw_deg
+            )
+        })
+        .collect();
+    println!(
+        "| largest base error per station ({}) | {:.3} |",
+        text.join("; "),
+        t.elapsed().as_secs_f64()
+    );
     println!(
         "verdict: {}",
         if analysis.ok {

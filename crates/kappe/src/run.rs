@@ -293,10 +293,13 @@ fn evaluate_until(
             &m.plan,
             &tol.base_tolerance(),
         )),
-        (Some(Ok(plan)), None) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
-            plan,
-            &tol.base_tolerance(),
-        )),
+        (Some(Ok(plan)), None) if tol.check => {
+            let mut rep = kappe_robot::tolerance::check_base_tolerance(plan, &tol.base_tolerance());
+            if tol.margins {
+                rep.margins = kappe_robot::tolerance::station_margins(plan, &tol.base_tolerance());
+            }
+            Some(rep)
+        }
         _ => None,
     };
     let mut verdict = crate::verdict::verdict(

@@ -236,10 +236,19 @@ pub fn station_sheet(
                 let prefix = format!("station {n},");
                 let bad = r.problems.iter().filter(|p| p.starts_with(&prefix)).count();
                 let (p, y) = (r.tolerance.position * 1e3, r.tolerance.yaw_deg);
-                if bad == 0 {
+                let verdict = if bad == 0 {
                     format!("±{p:.1} mm, ±{y:.1}°: survives")
                 } else {
                     format!("±{p:.1} mm, ±{y:.1}°: FAILS ({bad} problem(s))")
+                };
+                match r.margins.iter().find(|m| m.station == n) {
+                    Some(m) => format!(
+                        "{verdict}; takes up to {}±{:.1} mm, ±{:.2}°",
+                        if m.at_least { "at least " } else { "" },
+                        m.position_m * 1e3,
+                        m.yaw_deg
+                    ),
+                    None => verdict,
                 }
             }
         };

@@ -84,6 +84,22 @@ fn summary_says_fails(dir: &Path) -> bool {
         .is_some_and(|v| v.get("ok") == Some(&serde_json::Value::Bool(false)))
 }
 
+/// The base tolerance `kappe design` checked the plan in `dir` with (`summary.json`'s
+/// `robot.base_tolerance`) and whether it is in the verdict; `None` when no summary says.
+fn summary_tolerance(dir: &Path) -> Option<(kappe_robot::tolerance::BaseTolerance, bool)> {
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("summary.json")).ok()?).ok()?;
+    let t = v.get("robot")?.get("base_tolerance")?;
+    Some((
+        kappe_robot::tolerance::BaseTolerance {
+            position: t.get("position_m")?.as_f64()?,
+            yaw_deg: t.get("yaw_deg")?.as_f64()?,
+            stride: usize::try_from(t.get("stride")?.as_u64()?).ok()?,
+        },
+        t.get("in_verdict")?.as_bool()?,
+    ))
+}
+
 fn read(path: &Path) -> Result<String> {
     Ok(crate::input::read_text(path, "input file")?)
 }
@@ -261,6 +277,41 @@ pub fn run(cmd: RobotCommand) -> Result<ExitCode> {
                         .context(format!("resuming {} failed its check", plan_path.display()))),
                     r => r.map_err(anyhow::Error::new),
                 }?;
+            // The resumed plan's approach and re-cut programs are new motions: re-check them
+            // against the base tolerance the design was checked with (issue 28).
+            match summary_tolerance(&dir) {
+                Some((tol, in_verdict)) => {
+                    let rep = kappe_robot::tolerance::check_base_tolerance(&resumed, &tol);
+                    if rep.ok() {
+                        eprintln!(
+                            "base tolerance: the resumed plan survives a base up to ±{:.1} mm, ±{:.1}° off",
+                            tol.position * 1e3,
+                            tol.yaw_deg
+                        );
+                    } else if in_verdict && !allow_fail {
+                        eprintln!(
+                            "error: the resumed plan does not survive a base ±{:.1} mm, ±{:.1}° off ({} problem(s): {}); \
+                             no resume programs written. Rerun with --allow-fail to write them anyway",
+                            tol.position * 1e3,
+                            tol.yaw_deg,
+                            rep.problems.len(),
+                            rep.problems.first().map_or("", String::as_str)
+                        );
+                        return Ok(crate::exit::fails());
+                    } else {
+                        eprintln!(
+                            "warning: the resumed plan does not survive a base ±{:.1} mm, ±{:.1}° off ({} problem(s)); place the base precisely",
+                            tol.position * 1e3,
+                            tol.yaw_deg,
+                            rep.problems.len()
+                        );
+                    }
+                }
+                None => eprintln!(
+                    "base tolerance: not checked (no robot.base_tolerance in {})",
+                    dir.join("summary.json").display()
+                ),
+            }
             let prepared = prepare_dir(&out, false, "robot resume")?;
             write_plan_outputs(prepared.path(), &resumed, &programs)?;
             prepared.commit()?;

@@ -294,6 +294,87 @@ fn a_new_design_run_keeps_the_resume_programs_of_the_previous_one() {
     assert!(!d.join("o").join(&name).exists());
 }
 
+/// A resumed plan's new motions (the approach, the re-cut programs) are re-checked against the
+/// base tolerance the design was checked with (`summary.json`): the passing design's resume
+/// survives ±10 mm, ±1°; with the summary's tolerance raised to ±300 mm (the base would stand
+/// in the beams) the resume is refused with the reason and nothing is written, unless
+/// `--allow-fail`.
+#[test]
+fn resume_rechecks_the_base_tolerance() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    std::fs::write(d.join("p.toml"), PASSING).unwrap();
+    let o = kappe(
+        d,
+        &["design", "p.toml", "--out", "o", "--quiet", "--no-buckling"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let k = (first_layer(&d.join("o/plan.json")) + 1).to_string();
+    let resume = |out: &str, extra: &[&str]| {
+        let mut args = vec!["robot", "resume", "o", "--from-layer", &k, "--out", out];
+        args.extend_from_slice(extra);
+        kappe(d, &args)
+    };
+    let o = resume("r1", &[]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("resumed plan survives a base up to ±10.0 mm"),
+        "{err}"
+    );
+
+    let path = d.join("o/summary.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v["robot"]["base_tolerance"]["position_m"] = serde_json::json!(0.3);
+    std::fs::write(&path, serde_json::to_string(&v).unwrap()).unwrap();
+    let o = resume("r2", &[]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("does not survive a base ±300.0 mm") && err.contains("--allow-fail"),
+        "{err}"
+    );
+    assert!(!d.join("r2").exists(), "nothing written");
+    let o = resume("r3", &["--allow-fail"]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("warning: the resumed plan does not survive"),
+        "{err}"
+    );
+    assert!(!scripts(&d.join("r3")).is_empty());
+}
+
+/// `[robot.tolerance] margins = true`: every station's largest base error is in the summary
+/// and on the station sheet, and since the plan survives the stated box, each is at least 1×
+/// that box (a station that did not would fail the design).
+#[test]
+fn station_margins_reach_the_summary_and_the_sheet() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let design = format!("{PASSING}[robot.tolerance]\nmargins = true\n");
+    std::fs::write(d.join("p.toml"), design).unwrap();
+    let o = kappe(
+        d,
+        &["design", "p.toml", "--out", "o", "--quiet", "--no-buckling"],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("o/summary.json")).unwrap()).unwrap();
+    let stations = v["robot"]["stations"].as_array().unwrap().len();
+    let m = v["robot"]["base_tolerance"]["margins"].as_array().unwrap();
+    assert_eq!(m.len(), stations);
+    let sheet = std::fs::read_to_string(d.join("o/stations.md")).unwrap();
+    for (i, s) in m.iter().enumerate() {
+        assert_eq!(s["station"], i + 1);
+        let scale = s["scale"].as_f64().unwrap();
+        assert!((1.0..=4.0).contains(&scale), "{s}");
+        assert!((s["position_m"].as_f64().unwrap() - 0.01 * scale).abs() < 1e-12);
+    }
+    assert_eq!(sheet.matches("takes up to").count(), stations, "{sheet}");
+}
+
 /// The small cap of the green-state tests (34 states) with a Mohr–Coulomb cohesion of
 /// `cohesion` Pa growing by 20 Pa/s.
 fn cap_design(cohesion: f64) -> String {

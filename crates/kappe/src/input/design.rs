@@ -358,6 +358,10 @@ pub struct ToleranceSpec {
     /// the base search keeps the same margin, so the default design's plan survives ±10 mm,
     /// ±1°; a plan that does not is never written as "verified" without a word).
     pub verdict: bool,
+    /// Also find, per station, the largest base error it survives (the tolerance box scaled
+    /// up or down, `kappe_robot::tolerance::station_margins`), for the station sheet and
+    /// `summary.json`. Off by default: it costs about 3× the check.
+    pub margins: bool,
 }
 
 impl Default for ToleranceSpec {
@@ -369,6 +373,7 @@ impl Default for ToleranceSpec {
             yaw_deg: t.yaw_deg,
             stride: t.stride,
             verdict: true,
+            margins: false,
         }
     }
 }

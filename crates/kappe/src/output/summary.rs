@@ -392,6 +392,25 @@ pub struct BaseToleranceSummary {
     pub problems: Vec<String>,
     /// Whether a failure fails the design (`[robot.tolerance] verdict`).
     pub in_verdict: bool,
+    /// Per station, the largest base error it survives (with `[robot.tolerance] margins`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub margins: Vec<StationMarginSummary>,
+}
+
+/// How far one station's base may be off (`kappe_robot::tolerance::station_margins`): the
+/// tolerance box scaled until a corner fails, by bisection to 1/8 of the box.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct StationMarginSummary {
+    /// Station, 1-based.
+    pub station: usize,
+    /// The largest passing multiple of the tolerance box.
+    pub scale: f64,
+    /// Largest position error survived, m.
+    pub position_m: f64,
+    /// Largest yaw error survived, degrees.
+    pub yaw_deg: f64,
+    /// The search stopped at its upper end (4× the box): the station takes at least this.
+    pub at_least: bool,
 }
 
 /// The schedule block.
@@ -596,6 +615,17 @@ impl Outcome {
                         min_body_distance_m: t.min_body_distance,
                         problems: t.problems.clone(),
                         in_verdict: self.cap.design.robot.tolerance.verdict,
+                        margins: t
+                            .margins
+                            .iter()
+                            .map(|m| StationMarginSummary {
+                                station: m.station,
+                                scale: m.scale,
+                                position_m: m.position_m,
+                                yaw_deg: m.yaw_deg,
+                                at_least: m.at_least,
+                            })
+                            .collect(),
                     }),
                     base_trajectory: self
                         .moving

@@ -8,4 +8,5 @@ mod ladder;
 mod moving;
 mod plan;
 mod program;
+mod stations;
 mod sweep;

@@ -4,7 +4,7 @@ use kappe_robot::collision::Obstacle;
 use kappe_robot::frames::Iso;
 use kappe_robot::stations::{DriveSpec, fewest_stations, station_schedule};
 use kappe_robot::synthetic::cap_path;
-use kappe_robot::tolerance::{BaseTolerance, check_base_tolerance};
+use kappe_robot::tolerance::{BaseTolerance, check_base_tolerance, station_margins};
 use kappe_robot::*;
 
 /// Fewest contiguous ranges covering 0..n by dynamic programming over every split (the
@@ -130,6 +130,45 @@ fn base_tolerance_fails_a_plan_with_too_little_clearance() {
         ..BaseTolerance::default()
     };
     assert!(check_base_tolerance(&p, &zero).ok());
+}
+
+/// The largest base error a station survives (issue 28): with a wall 40 mm behind the base body,
+/// the body's back corners move toward it by about s · (10 mm + 0.41 m · sin 1°) = s · 17.2 mm
+/// at s times the default box, so the body touches at s ≈ 40 / 17.2 = 2.33. The margin must be
+/// the smaller of that and the station's margin without the wall, to within the search's
+/// resolution (0.125) and the rounding of the 0.41 m lever (≤ 0.05 in s); and the check at the
+/// found box must pass while a box 0.25 larger fails.
+#[test]
+fn station_margin_stops_where_the_base_would_touch_the_wall() {
+    let (layers, setup, opts) = small(3);
+    let plan = plan_print(&layers, &setup, &opts).unwrap();
+    let tol = BaseTolerance::default();
+    let free = station_margins(&plan, &tol);
+    assert_eq!(free.len(), plan.stations.len());
+    let mut p = plan.clone();
+    p.setup.obstacles.push(wall_behind(0.040));
+    let walled = station_margins(&p, &tol);
+    let touch = 0.040 / (0.010 + 0.41 * 1f64.to_radians().sin());
+    for (f, w) in free.iter().zip(&walled) {
+        assert_eq!(f.station, w.station);
+        let expected = f.scale.min(touch);
+        assert!(
+            (w.scale - expected).abs() <= 0.125 + 0.05,
+            "station {}: margin {} against {expected} (free {})",
+            w.station,
+            w.scale,
+            f.scale
+        );
+        assert!(!w.at_least);
+        assert!((w.position_m - w.scale * tol.position).abs() < 1e-15);
+        let at = |s: f64| BaseTolerance {
+            position: s * tol.position,
+            yaw_deg: s * tol.yaw_deg,
+            ..tol.clone()
+        };
+        assert!(check_base_tolerance(&p, &at(w.scale)).ok());
+        assert!(!check_base_tolerance(&p, &at(w.scale + 0.25)).ok());
+    }
 }
 
 /// The schedule of a plan: ranges contiguous and ordered, relocation = distance / speed + settle.
