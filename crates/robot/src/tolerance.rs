@@ -337,8 +337,9 @@ pub fn station_margins(plan: &Plan, tol: &BaseTolerance) -> Vec<StationMargin> {
     let Ok(ctx) = validate(&layers, &plan.setup, &plan.options) else {
         return Vec::new();
     };
-    if !(tol.position.is_finite() && tol.position >= 0.0)
-        || !(tol.yaw_deg.is_finite() && tol.yaw_deg >= 0.0)
+    let finite = |v: f64| v.is_finite() && v >= 0.0;
+    if !finite(tol.position)
+        || !finite(tol.yaw_deg)
         || tol.stride == 0
         || (tol.position == 0.0 && tol.yaw_deg == 0.0)
     {
