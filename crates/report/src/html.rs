@@ -280,6 +280,7 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
     if let Some(r) = &input.robot_summary {
         h.push_str(&crate::robot_summary::section_html(r));
     }
+    h.push_str(&crate::placement::section_html(input)?);
 
     // Plots, each with the data needed to draw the cursor of the current moment.
     let _ = write!(
@@ -340,7 +341,7 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
 }
 
 /// Inline SVG in HTML must not carry an XML declaration.
-fn strip_xml_declaration(svg: &str) -> &str {
+pub(crate) fn strip_xml_declaration(svg: &str) -> &str {
     let s = svg.trim_start();
     if s.starts_with("<?xml")
         && let Some(end) = s.find("?>")

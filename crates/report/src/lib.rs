@@ -53,6 +53,7 @@ mod error;
 mod html;
 mod input;
 mod island;
+mod placement;
 mod plots;
 mod robot_summary;
 mod schedule;
@@ -70,6 +71,7 @@ pub use input::{
     Timeline, Vec3, WorstPlace,
 };
 pub use island::read_island;
+pub use placement::{PlacementShapes, StationShape, placement_shapes, placement_svg};
 pub use plots::{
     CursorAxis, PLOT_SIZE, PlotFrame, PlotSpec, ReferenceLine, RenderedPlot, VerticalMarker,
     fmt_num, render_plot, render_svg, standard_plots,

@@ -2,6 +2,7 @@
 
 mod demo;
 mod html;
+mod placement;
 mod study;
 mod validate;
 
