@@ -225,7 +225,7 @@ pub fn tracking_program_files(
         let base_s0 = Iso::new(start.r, start.t + d * s0);
         let s0_from_world = base_s0.inverse();
         let fname = format!("{prefix}{:02}.script", pi + 1);
-        let func = format!("kappe_track_{:02}", pi + 1);
+        let func = format!("kappe_track_{:02}{}", pi + 1, plan.mark.function_suffix());
         let mut w = String::new();
         let mut depth = 1usize;
         let mut line = |s: &str, dd: &mut usize| {
@@ -499,11 +499,18 @@ pub fn tracking_program_files(
             )]));
         }
         let mut text = String::new();
+        let title = plan.mark.title();
         text.push_str(&format!(
-            "# Kappe print program {}/{} for a UR10e on a moving base (conveyor tracking; generated, verified by kappe-robot)\n",
+            "# Kappe print program {}/{} for a UR10e on a moving base{} (conveyor tracking; generated, verified by kappe-robot)\n",
             pi + 1,
-            n_parts
+            n_parts,
+            if title.is_empty() {
+                String::new()
+            } else {
+                format!(" -- {title}")
+            }
         ));
+        text.push_str(&plan.mark.header_lines());
         text.push_str(&format!(
             "# layers {}..{}, {} motion targets; starts at base travel {} m, plan time {} s to {} s\n",
             part.first_layer,
@@ -563,6 +570,9 @@ pub fn tracking_index_json(files: &[(ProgramFile, TrackingStart)]) -> String {
                 "base_yaw_rad": m[1][0].atan2(m[0][0]),
                 "start_s": f.start,
                 "end_s": f.end,
+                "title": f.mark.title(),
+                "failing_design": f.mark.failing_design,
+                "resumed_from_layer": f.mark.resumed_from_layer,
             })
         })
         .collect();

@@ -174,6 +174,29 @@ impl PlanMark {
         words.join(", ")
     }
 
+    /// The comment lines every program of a marked plan starts with after its title (station
+    /// and tracking programs alike): the failing design's warning, the resume note and the
+    /// operator's guide.
+    pub fn header_lines(&self) -> String {
+        let mut text = String::new();
+        if let Some(why) = &self.failing_design {
+            let why = why.split_whitespace().collect::<Vec<_>>().join(" ");
+            text.push_str(&format!(
+                "# WARNING: the design FAILS its checks ({why}); written only because of --allow-fail\n"
+            ));
+        }
+        if let Some(k) = self.resumed_from_layer {
+            text.push_str(&format!(
+                "# RESUME: continues an interrupted print from layer {k}; the layers before it must stand\n"
+            ));
+        }
+        text.push_str(
+            "# operator's guide: docs/operator.md in the Kappe repository (origin, base placement, \
+             stopped prints)\n",
+        );
+        text
+    }
+
     /// The suffix of a program's function name, e.g. `_resume_m45_failing`; empty when plain.
     /// URScript names allow only letters, digits and `_`, so a negative layer is `m45`.
     pub fn function_suffix(&self) -> String {

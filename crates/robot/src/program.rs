@@ -495,21 +495,7 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
                 format!(" -- {title}")
             }
         ));
-        if let Some(why) = &plan.mark.failing_design {
-            text.push_str(&format!(
-                "# WARNING: the design FAILS its checks ({}); written only because of --allow-fail\n",
-                one_line(why)
-            ));
-        }
-        if let Some(k) = plan.mark.resumed_from_layer {
-            text.push_str(&format!(
-                "# RESUME: continues an interrupted print from layer {k}; the layers before it must stand\n"
-            ));
-        }
-        text.push_str(
-            "# operator's guide: docs/operator.md in the Kappe repository (origin, base placement, \
-             stopped prints)\n",
-        );
+        text.push_str(&plan.mark.header_lines());
         text.push_str(&format!(
             "# station {}: base at x {:.3} m, y {:.3} m, yaw {:.1}° (stations.md); layers {} to {}, {} motion targets\n",
             part.station + 1 + plan.mark.station_offset,
@@ -543,10 +529,6 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
 }
 
 /// A reason on one comment line (a newline would end the URScript comment).
-fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
 /// The title of program `i` of `n`, as its first line says it.
 fn program_title(f: &ProgramFile, i: usize, n: usize) -> String {
     let mark = f.mark.title();

@@ -176,6 +176,19 @@ fn moving_example_runs() {
         tmp.path(),
         &["robot", "lint", "r/resume_part01.script"],
     ));
+    // A resumed tracking program says so, as a resumed station program does (issue 27): title,
+    // RESUME line, function name, and the index.
+    let prog = std::fs::read_to_string(r.join("resume_part01.script")).unwrap();
+    let head: Vec<&str> = prog.lines().take(3).collect();
+    assert!(head[0].contains("RESUME FROM LAYER 3"), "{head:?}");
+    assert!(head.iter().any(|l| l.starts_with("# RESUME:")), "{head:?}");
+    assert!(
+        prog.contains("def kappe_track_01_resume_3"),
+        "function name"
+    );
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(r.join("programs.json")).unwrap()).unwrap();
+    assert_eq!(index["programs"][0]["resumed_from_layer"], 3);
     // The resumed trajectory starts at layer 3: fewer rows than the whole print's.
     let rows = |p: &str| {
         std::fs::read_to_string(tmp.path().join(p))
