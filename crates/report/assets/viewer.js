@@ -492,6 +492,7 @@
         times: f32(data.robot.times),
         joints: f32(data.robot.joints),
         station: i32(data.robot.station),
+        base: data.robot.base ? f32(data.robot.base) : new Float32Array(0),
         poses: f32(data.robot.poses),
         radii: data.robot.link_radii,
       }
@@ -670,7 +671,14 @@
       const si = stationOf(i);
       const sj = stationOf(j);
       baseM.copy(stationMat[si] || new THREE.Matrix4());
-      if (si !== sj && stationMat[sj]) {
+      if (robot.base.length >= 3 * (j + 1)) {
+        // A moving base (issue 27): its pose at this moment, x, y and yaw interpolated between
+        // the two frames, at the first station's height.
+        const b = robot.base;
+        const lerp = (k) => b[3 * i + k] + w * (b[3 * j + k] - b[3 * i + k]);
+        const z = new THREE.Vector3().setFromMatrixPosition(stationMat[0] || new THREE.Matrix4()).z;
+        baseM.makeRotationZ(lerp(2)).setPosition(lerp(0), lerp(1), z);
+      } else if (si !== sj && stationMat[sj]) {
         const pa = new THREE.Vector3();
         const pb = new THREE.Vector3();
         const qa = new THREE.Quaternion();

@@ -338,6 +338,11 @@ pub struct RobotAnimation {
     /// Station (index into [`Cell::stations`]) of each step; empty when there is one station.
     #[serde(default)]
     pub station: Vec<usize>,
+    /// A base that moves while the arm prints (issue 27): the base pose of each step in the
+    /// world, `[x, y, yaw]` (m, m, rad; the height is the first station's); empty when the base
+    /// stands at its stations.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub base: Vec<[f64; 3]>,
 }
 
 /// A line plot rendered as inline SVG.
@@ -771,6 +776,16 @@ impl RobotAnimation {
                     value: s as f64,
                     allowed: "an index into cell.stations",
                 });
+            }
+        }
+        if !self.base.is_empty() {
+            if self.base.len() != n {
+                return Err(mismatch("robot.base".into(), self.base.len(), n));
+            }
+            for (i, b) in self.base.iter().enumerate() {
+                for (j, v) in b.iter().enumerate() {
+                    finite(|| format!("robot.base[{i}][{j}]"), *v)?;
+                }
             }
         }
         let mut last = f64::NEG_INFINITY;

@@ -338,6 +338,7 @@ pub(crate) fn island(input: &ReportInput) -> Value {
             "station": b64_i32(r.station.iter().map(|&s| s as i64)),
             "link_radii": r.link_radii,
             "poses": b64_f32(r.poses.iter().flatten().flatten().flatten().copied()),
+            "base": b64_f32(r.base.iter().flatten().copied()),
         })
     });
 
@@ -598,6 +599,11 @@ pub fn read_island(json: &str) -> Result<ReportInput, ReportError> {
                     .into_iter()
                     .map(|s| usize::try_from(s).unwrap_or(usize::MAX))
                     .collect(),
+                // Pages written before the moving base have no `base`.
+                base: match r.get("base") {
+                    Some(b) if !b.is_null() => triples(d_f32(b, "robot.base")?),
+                    _ => Vec::new(),
+                },
             })
         }
         _ => None,

@@ -39,6 +39,8 @@ pub struct PlacementShapes {
     pub footprint: Vec<Vec<[f64; 2]>>,
     /// The stations in print order.
     pub stations: Vec<StationShape>,
+    /// A base that moves while printing: the path of the robot base origin (empty otherwise).
+    pub base_path: Vec<[f64; 2]>,
 }
 
 /// The outline of `b` seen from above: its centre and half extents rotated by its yaw, then
@@ -103,10 +105,16 @@ pub fn placement_shapes(input: &ReportInput) -> Option<PlacementShapes> {
             }
         })
         .collect();
+    let base_path = input
+        .robot
+        .as_ref()
+        .map(|r| r.base.iter().map(|b| [b[0], b[1]]).collect())
+        .unwrap_or_default();
     Some(PlacementShapes {
         obstacles,
         footprint,
         stations,
+        base_path,
     })
 }
 
@@ -140,7 +148,8 @@ pub fn placement_svg(shapes: &PlacementShapes) -> Result<String, ReportError> {
                 .stations
                 .iter()
                 .flat_map(|s| s.outlines.iter().flatten().copied().chain([s.origin])),
-        );
+        )
+        .chain(shapes.base_path.iter().copied());
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for [x, y] in pts {
         x0 = x0.min(x);
@@ -205,6 +214,34 @@ pub fn placement_svg(shapes: &PlacementShapes) -> Result<String, ReportError> {
                 )
             }))
             .map_err(|e| err(&e))?;
+        if let (Some(first), Some(last)) = (shapes.base_path.first(), shapes.base_path.last()) {
+            let black = RGBColor(40, 40, 40);
+            chart
+                .draw_series([PathElement::new(
+                    shapes
+                        .base_path
+                        .iter()
+                        .map(|p| (p[0], p[1]))
+                        .collect::<Vec<_>>(),
+                    black.stroke_width(2),
+                )])
+                .map_err(|e| err(&e))?;
+            chart
+                .draw_series([Circle::new((last[0], last[1]), 5, black.filled())])
+                .map_err(|e| err(&e))?;
+            chart
+                .draw_series([Text::new(
+                    format!(
+                        "base at the end: x {:.3}, y {:.3} ({:.2} m travelled)",
+                        last[0],
+                        last[1],
+                        (last[0] - first[0]).hypot(last[1] - first[1])
+                    ),
+                    (last[0], last[1]),
+                    ("sans-serif", 14).into_font().color(&black),
+                )])
+                .map_err(|e| err(&e))?;
+        }
         for st in &shapes.stations {
             let colour = COLOURS[(st.number - 1) % COLOURS.len()];
             for o in &st.outlines {
@@ -286,7 +323,8 @@ pub fn section_html(input: &ReportInput) -> Result<String, ReportError> {
          <p>Plan view of the cell, world frame (docs/operator.md: origin on the beams' top face \
          midway between their inner faces where layer 0 meets them; x across the span, y along \
          the beams). Each station: the mobile base's outline, the robot base origin (dot) and the \
-         direction of its x axis (line, {ARROW} m). The station sheet (<code>stations.md</code>) \
+         direction of its x axis (line, {ARROW} m); a base that moves while printing starts at \
+         station 1 and follows the black line. The station sheet (<code>stations.md</code>) \
          gives the tolerance each must be placed to.</p>\n<figure aria-label=\"base placement\">{}</figure>\n\
          <table><thead><tr><th>station</th><th>base x [m]</th><th>base y [m]</th>\
          <th>base yaw [°]</th><th>layers</th></tr></thead><tbody>\n",

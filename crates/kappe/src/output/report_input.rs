@@ -881,6 +881,18 @@ impl crate::Outcome {
         if let Some(plan) = &self.robot {
             add_robot(&mut extras, plan);
         }
+        // A moving base (issue 27): the arm's base follows the base trajectory, frame by frame,
+        // as `base_trajectory.csv` has it.
+        if let (Some(m), Some(anim)) = (&self.moving, extras.robot.as_mut()) {
+            anim.base = anim
+                .times
+                .iter()
+                .map(|&t| {
+                    let s = m.plan.trajectory.sample_at(t);
+                    [s.base_x, s.base_y, s.base_yaw]
+                })
+                .collect();
+        }
         // The constraint table says whether the plan survives its stated base error (issue 28).
         if let Some(r) = &self.base_tolerance {
             let tol = &self.cap.design.robot.tolerance;

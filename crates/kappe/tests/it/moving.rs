@@ -124,6 +124,28 @@ fn moving_base_default_cap_end_to_end() {
     assert!(b["max_speed_m_s"].as_f64().unwrap() <= 0.1 + 1e-12);
     assert!(b["tracking"]["max_deviation_m"].as_f64().unwrap() > 0.0);
     assert!(b["tracking"]["at_layer"].is_i64());
+
+    // The report's arm rides on the moving base: a base pose per animation frame, the first at
+    // the plan's start pose and every one on base_trajectory.csv at the frame's time (1e-6 m,
+    // as above).
+    let input = out.report_input();
+    let anim = input.robot.as_ref().expect("an animation");
+    assert_eq!(anim.base.len(), anim.times.len());
+    let start = plan.stations[0].world_from_base;
+    assert!((anim.base[0][0] - start[0][3]).abs() < 1e-6);
+    assert!((anim.base[0][1] - start[1][3]).abs() < 1e-6);
+    for (t, p) in anim.times.iter().zip(&anim.base).step_by(97) {
+        let b = base_at(&brows, *t);
+        assert!(
+            (p[0] - b[0]).abs() <= 1e-6 && (p[1] - b[1]).abs() <= 1e-6,
+            "t = {t}: {p:?} vs {b:?}"
+        );
+    }
+    let travelled = (anim.base.last().unwrap()[1] - anim.base[0][1]).abs();
+    assert!(
+        travelled > 0.1,
+        "the base moves in the report: {travelled} m"
+    );
 }
 
 #[test]

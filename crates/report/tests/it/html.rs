@@ -177,8 +177,8 @@ fn failed_constraints_are_highlighted() {
 fn plots_are_inline_svg_and_follow_the_data() {
     let mut input = demo_input();
     let html = render_html(&input).unwrap();
-    // BLF, stress, overhang, joint angles, the demo's layer age.
-    assert_eq!(html.matches("<figure").count(), 5);
+    // BLF, stress, overhang, joint angles, the demo's layer age, and the base placement.
+    assert_eq!(html.matches("<figure").count(), 6);
     assert!(!html.contains("<?xml"));
     for title in [
         "Buckling load factor vs print progress",
@@ -194,7 +194,8 @@ fn plots_are_inline_svg_and_follow_the_data() {
         s.blf = None;
     }
     let html = render_html(&input).unwrap();
-    assert_eq!(html.matches("<figure").count(), 3);
+    // Stress, overhang, layer age and the base placement (the cell is still there).
+    assert_eq!(html.matches("<figure").count(), 4);
 }
 
 #[test]
