@@ -23,19 +23,19 @@ chromium --version 2>/dev/null | head -1 || true
 
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
-cargo run --quiet -p kappe-report --example demo -- "$OUT/report.html"
+cargo run --release --quiet -p kappe-report --example demo -- "$OUT/report.html"
 KAPPE_REPORT="$OUT/report.html" node --test web/e2e/
 
-# The same checks on a report written by `kappe design` itself: a short cap (quick in a debug
-# build) with the analysis and the robot plan, so every panel of the page holds real data.
+# The same checks on a report written by `kappe design` itself: a short cap with the analysis
+# and the robot plan, so every panel of the page holds real data. Release builds throughout:
+# scripts/test.sh has built them already, so CI compiles the workspace once, not twice.
 printf '[cap]\nlength = 0.15\n' > "$OUT/short.toml"
-cargo run --quiet -p kappe-cli -- design "$OUT/short.toml" --out "$OUT/design" --quiet --states every:4
+cargo run --release --quiet -p kappe-cli -- design "$OUT/short.toml" --out "$OUT/design" --quiet --states every:4
 KAPPE_REPORT="$OUT/design/report.html" node --test web/e2e/
 
 # A base that moves while printing (issue 27): the arm rides on the base trajectory, so the drawn
 # nozzle stays on the layer being printed (the test's nozzle check fails if the viewer left the
-# base at its start). Release build: the moving planner is slow unoptimised, and scripts/test.sh
-# has built it already.
+# base at its start).
 printf '[cap]\nlength = 0.15\n[robot.beams]\noverrun = 0.05\n[robot.base]\nmode = "moving"\n[robot.tolerance]\nverdict = false\n' > "$OUT/moving.toml"
 cargo run --release --quiet -p kappe-cli -- design "$OUT/moving.toml" --out "$OUT/moving" --quiet --states every:4
 KAPPE_REPORT="$OUT/moving/report.html" node --test web/e2e/
@@ -43,5 +43,5 @@ KAPPE_REPORT="$OUT/moving/report.html" node --test web/e2e/
 # A failing design (a flat, wide cap: sigma_min fails): the page must work just as well, with
 # the failing rows and their places.
 printf '[cap]\nspan = 1.4\nrise = 0.12\nlength = 0.15\n' > "$OUT/fail.toml"
-cargo run --quiet -p kappe-cli -- design "$OUT/fail.toml" --out "$OUT/fail" --quiet --states every:4 --allow-fail
+cargo run --release --quiet -p kappe-cli -- design "$OUT/fail.toml" --out "$OUT/fail" --quiet --states every:4 --allow-fail
 KAPPE_REPORT="$OUT/fail/report.html" node --test web/e2e/
