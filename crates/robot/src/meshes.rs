@@ -540,10 +540,18 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
     along.environment = at(0);
     along.nozzle = at(1);
     along.self_distance = at(2);
+    let mut rep = report_of(&out, &meshes, Some(along));
+    rep.problems.extend(along_problems);
+    Ok(rep)
+}
+
+/// The report of measured configurations `out`: the least clearance of each model and where,
+/// and a problem per contact (at most 20).
+fn report_of(out: &[One], meshes: &ArmMeshes, along: Option<AlongMotion>) -> MeshReport {
     let mut rep = MeshReport {
         waypoints_checked: out.len(),
         mesh_vertices: meshes.vertices.clone(),
-        along_motion: Some(along),
+        along_motion: along,
         ..Default::default()
     };
     for (k, o) in out.iter().enumerate() {
@@ -596,8 +604,92 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
             ));
         }
     }
-    rep.problems.extend(along_problems);
-    Ok(rep)
+    rep
+}
+
+/// [`verify_meshes`] for a base that moves while printing (issue 27): every `stride`-th
+/// waypoint of each layer (and its first and last), the arm posed from the base's pose at that
+/// waypoint ([`crate::moving::MovingPlan::base_pose`]). The environment (beams, floor, printed
+/// layers) stands in the world; the mobile base's own body moves with the arm, so the arm's
+/// distance to it is measured in the base frame, independent of the travel. At the waypoints
+/// only: the clearance along the motion with the base moving is certified on the capsules by
+/// [`crate::moving::check_moving`].
+///
+/// # Errors
+/// An invalid plan (shape, setup, targets) or mesh asset.
+pub fn verify_meshes_moving(
+    mp: &crate::moving::MovingPlan,
+    stride: usize,
+) -> Result<MeshReport, RobotError> {
+    mp.validate_shape()?;
+    let stride = stride.max(1);
+    let plan = &mp.plan;
+    let meshes = ArmMeshes::load()?;
+    let layers = crate::check::plan_layers(plan);
+    let mut world_setup = plan.setup.clone();
+    world_setup.mobile_base.clear();
+    let ctx = validate(&layers, &world_setup, &plan.options)?;
+    let world = ctx.scene(&Iso::IDENTITY)?;
+    let boxes: Vec<_> = plan
+        .setup
+        .mobile_base
+        .iter()
+        .map(|b| b.to_world(&Iso::IDENTITY))
+        .collect();
+    let body = if boxes.is_empty() {
+        None
+    } else {
+        Some(crate::collision::Scene::new(&boxes)?)
+    };
+    let tool_caps: Vec<_> = ctx
+        .self_model
+        .capsules
+        .iter()
+        .filter(|c| c.link == TOOL_LINK)
+        .cloned()
+        .collect();
+    let mut jobs: Vec<(usize, usize, i64, usize, Joints)> = Vec::new();
+    for (o, l) in plan.stations[0].layers.iter().enumerate() {
+        let n = l.waypoints.len();
+        for (k, w) in l.waypoints.iter().enumerate() {
+            if k % stride == 0 || k + 1 == n {
+                jobs.push((o, k, l.layer, w.index, w.q));
+            }
+        }
+    }
+    let out: Vec<One> = jobs
+        .par_iter()
+        .map(|&(o, k, layer, index, q)| {
+            let probe = Probe {
+                ctx: &ctx,
+                meshes: &meshes,
+                scene: &world,
+                world_from_base: mp.base_pose(o, k),
+                tool_caps: &tool_caps,
+            };
+            let mut one = probe.measure(&q, o);
+            if let Some(body) = &body {
+                let on_base = Probe {
+                    scene: body,
+                    world_from_base: Iso::IDENTITY,
+                    ..probe
+                };
+                let b = on_base.measure(&q, o);
+                for (mine, theirs) in [
+                    (&mut one.cap_env, b.cap_env),
+                    (&mut one.nozzle, b.nozzle),
+                    (&mut one.mesh_env, b.mesh_env),
+                ] {
+                    if theirs.0 < mine.0 {
+                        *mine = theirs;
+                    }
+                }
+            }
+            one.at = (0, layer, index);
+            one
+        })
+        .collect();
+    Ok(report_of(&out, &meshes, None))
 }
 
 /// Run [`verify_meshes`] and keep the report in the plan (`Plan::meshes`); a mesh contact is an

@@ -896,7 +896,20 @@ fn plan_with_lead(
     if !mp.check.problems.is_empty() {
         return Err(RobotError::Verification(mp.check.problems.clone()));
     }
+    attach_moving_meshes(&mut mp)?;
     Ok(mp)
+}
+
+/// UR's collision meshes at every waypoint with the base where it is at that moment
+/// ([`crate::meshes::verify_meshes_moving`]), kept in the plan (`Plan::meshes`); a mesh contact
+/// is a failed verification.
+fn attach_moving_meshes(mp: &mut MovingPlan) -> Result<(), RobotError> {
+    let rep = crate::meshes::verify_meshes_moving(mp, 1)?;
+    if !rep.problems.is_empty() {
+        return Err(RobotError::Verification(rep.problems));
+    }
+    mp.plan.meshes = Some(rep);
+    Ok(())
 }
 
 /// The base trajectory of a timed plan: a sample at the start of the clock (the approach, base
@@ -1265,6 +1278,7 @@ pub fn resume_moving(mp: &MovingPlan, layer: i64) -> Result<MovingPlan, RobotErr
     if !out.check.problems.is_empty() {
         return Err(RobotError::Verification(out.check.problems.clone()));
     }
+    attach_moving_meshes(&mut out)?;
     Ok(out)
 }
 

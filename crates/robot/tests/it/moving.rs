@@ -551,3 +551,85 @@ fn a_mirrored_bay_moves_the_base_along_minus_y() {
         simulate_tracking(&mp, &TrackingErrors::none(), &TrackingTolerance::default()).unwrap();
     assert!(rep.max_deviation <= 1e-6, "{}", rep.max_deviation);
 }
+
+/// UR's collision meshes on a moving plan (issue 27): the plan carries the report, one row per
+/// waypoint. With the travel set to 0 the base stands at its start pose, so the moving check
+/// (world scene + the base's own body measured in the base frame) must give the station check's
+/// waypoint clearances on the same plan to 1e-9 m (the same geometry, transformed differently).
+/// And a small box put in the world where one waypoint's flange is, with the base at that
+/// waypoint's pose, is found touching.
+#[test]
+fn collision_meshes_are_checked_with_the_base_where_it_is() {
+    let mp = planned();
+    let rep = mp
+        .plan
+        .meshes
+        .as_ref()
+        .expect("mesh report on a moving plan");
+    assert_eq!(rep.waypoints_checked, mp.plan.waypoint_count());
+    assert!(rep.problems.is_empty(), "{:?}", rep.problems);
+
+    // The first 4 layers, every 5th waypoint (and each layer's first and last): the station
+    // check also certifies the motion between waypoints, which is slow on this plan.
+    let mut still = mp.clone();
+    still.plan.stations[0].layers.truncate(4);
+    still.travel.truncate(4);
+    still.plan.parts.clear();
+    for l in &mut still.travel {
+        l.iter_mut().for_each(|s| *s = 0.0);
+    }
+    let moving = meshes::verify_meshes_moving(&still, 5).unwrap();
+    let station = meshes::verify_meshes(&still.plan, 5).unwrap();
+    for (a, b, what) in [
+        (
+            &moving.capsules.environment,
+            &station.capsules.environment,
+            "capsules",
+        ),
+        (
+            &moving.meshes.environment,
+            &station.meshes.environment,
+            "meshes",
+        ),
+        (&moving.nozzle, &station.nozzle, "nozzle"),
+        (
+            &moving.meshes.self_distance,
+            &station.meshes.self_distance,
+            "self",
+        ),
+    ] {
+        assert!(
+            (a.distance - b.distance).abs() < 1e-9,
+            "{what}: moving {} vs station {}",
+            a.distance,
+            b.distance
+        );
+    }
+
+    // Layer 10, waypoint 20: the flange in the world with the base where it is then.
+    let (o, k) = (10, 20);
+    let q = mp.plan.stations[0].layers[o].waypoints[k].q;
+    let flange = mp.base_pose(o, k).mul(&kinematics::UR10E.fk(&q)).t;
+    let start = Iso::from_mat4(&mp.plan.stations[0].world_from_base).unwrap();
+    let moved = (mp.base_pose(o, k).t - start.t).length();
+    assert!(moved > 0.05, "the base has travelled {moved} m by then");
+    let mut hit = mp.clone();
+    hit.plan.setup.obstacles.push(collision::Obstacle::Box {
+        name: "probe".into(),
+        center: flange.to_array(),
+        half_extents: [0.01, 0.01, 0.01],
+        yaw: 0.0,
+    });
+    let rep = meshes::verify_meshes_moving(&hit, 5).unwrap();
+    // The arm passes there at neighbouring layers too, and the list stops at 20 entries: it is
+    // enough that the probe is found touching.
+    assert!(
+        !rep.problems.is_empty() && rep.problems.iter().all(|p| p.contains("probe")),
+        "{:?}",
+        rep.problems
+    );
+    assert_eq!(
+        rep.meshes.environment.distance.min(rep.nozzle.distance),
+        0.0
+    );
+}
