@@ -18,9 +18,11 @@ use crate::form::states::build_state;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 
-/// Consecutive states per warm-started run of the graded analysis: each run's first state
-/// starts cold, so longer runs save more Lanczos steps; shorter ones balance the cores better.
-const WARM_RUN: usize = 32;
+/// Consecutive states per warm-started run: each run's first state starts cold, so longer runs
+/// save more Lanczos steps; shorter ones balance the cores better. 16: the default cap's 113
+/// states in 8 runs instead of 4, so the last run no longer finishes alone (four more cold
+/// starts, about five Lanczos steps each).
+const WARM_RUN: usize = 16;
 
 /// The analysis of one print state.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -644,16 +646,28 @@ pub(crate) fn analyze_scheduled(
     let first_modes = first_modes.into_inner().unwrap_or_default();
     let mut fe = fe;
     let interpolated = converge_fe(options, &mut fe, &mut |states, opts| {
-        states
-            .par_iter()
-            .map(|&top| {
-                cancelled()?;
-                match first_modes.get(&top) {
-                    Some((f1, mode)) => state_fe_refine(cap, opts, top, *f1, mode),
-                    None => state_fe_with(cap, opts, green.as_ref(), top, &mut None),
+        // Largest state first, each core taking the next state as it finishes (longest
+        // processing time first): a batch of a few split meshes of very different sizes left a
+        // core idle behind the largest one under rayon's halving of the slice.
+        let mut order = states.to_vec();
+        order.sort_unstable_by(|a, b| b.cmp(a));
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let workers = rayon::current_num_threads().clamp(1, order.len().max(1));
+        let parts = (0..workers)
+            .into_par_iter()
+            .map(|_| {
+                let mut out = Vec::new();
+                while let Some(&top) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    cancelled()?;
+                    out.push(match first_modes.get(&top) {
+                        Some((f1, mode)) => state_fe_refine(cap, opts, top, *f1, mode),
+                        None => state_fe_with(cap, opts, green.as_ref(), top, &mut None),
+                    }?);
                 }
+                Ok(out)
             })
-            .collect()
+            .collect::<Result<Vec<_>, DesignError>>()?;
+        Ok(parts.into_iter().flatten().collect())
     })?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
     assemble(
