@@ -629,10 +629,10 @@ pub(crate) fn analyze_scheduled(
             for top in run {
                 cancelled()?;
                 let f = state_fe(cap, options, green.as_ref(), top, &mut guess)?;
-                if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first()) {
-                    if let Ok(mut m) = first_modes.lock() {
-                        m.insert(top, (f1, g.clone()));
-                    }
+                if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first())
+                    && let Ok(mut m) = first_modes.lock()
+                {
+                    m.insert(top, (f1, g.clone()));
                 }
                 out.push(f);
                 on_state(n_fe);

@@ -126,7 +126,10 @@ fn the_split_pass_continues_from_the_first_pass() {
         ..o.clone()
     };
     let (b, _, mode) = state_buckling_warm(&state, &mat, &first, None).unwrap();
-    assert!(b.convergence.is_none(), "the first pass solves the layer mesh only");
+    assert!(
+        b.convergence.is_none(),
+        "the first pass solves the layer mesh only"
+    );
     let split_opts = AnalysisOptions {
         blf_max_split: 2,
         ..o.clone()
