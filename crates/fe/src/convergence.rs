@@ -104,14 +104,40 @@ pub fn converge_factor(
     let Some(&f0) = coarse.factors.first() else {
         return Ok(None);
     };
-    let mut levels = vec![MeshLevel {
+    let level = MeshLevel {
         split: 1,
         factor: f0,
         n_free_dofs: coarse.stats.n_free_dofs,
         steps: coarse.stats.operator_applications,
-    }];
+    };
+    converge_from(
+        model,
+        level,
+        coarse.modes.first().cloned(),
+        options,
+        tolerance,
+        max_split,
+    )
+}
+
+/// [`converge_factor`] from a coarse solve done earlier: its level `coarse` and its mode 1
+/// (per node of `model`, the start of the first split's Lanczos; `None`: a random start). The
+/// print states' mesh-error pass solves the print-layer meshes once, in its first pass, and
+/// continues here without solving them again (docs/convergence.md, "Speed").
+///
+/// # Errors
+/// A split mesh that cannot be solved.
+pub fn converge_from(
+    model: &ShellModel,
+    coarse: MeshLevel,
+    mode: Option<Vec<[f64; 6]>>,
+    options: &BucklingOptions,
+    tolerance: f64,
+    max_split: usize,
+) -> Result<Option<ConvergedFactor>, FeError> {
+    let mut levels = vec![coarse];
     let mut current = model.clone();
-    let mut mode = coarse.modes.first().cloned();
+    let mut mode = mode.filter(|m| m.len() == model.nodes.len());
     let mut split_n = 1;
     loop {
         let refined = split(&current, 2);

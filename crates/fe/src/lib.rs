@@ -61,7 +61,7 @@ pub mod refine;
 mod solver;
 pub mod summary;
 
-pub use convergence::{ConvergedFactor, MeshLevel, converge_factor};
+pub use convergence::{ConvergedFactor, MeshLevel, converge_factor, converge_from};
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use nonlinear::{

@@ -166,32 +166,10 @@ pub fn state_buckling_warm(
             ));
         }
     };
-    // First network index of every layer: the network stores each layer contiguously.
-    let mut first: HashMap<i32, usize> = HashMap::new();
-    for (i, n) in state.network.nodes.iter().enumerate() {
-        if n.role != crate::form::states::Role::ColumnEnd {
-            first.entry(n.layer).or_insert(i);
-        }
-    }
-    let keys: Vec<Option<(i32, usize)>> = shell
-        .network_node
-        .iter()
-        .map(|&k| {
-            let i = analysed.full_index(k)?;
-            let layer = state.network.nodes.get(i)?.layer;
-            Some((layer, i.checked_sub(*first.get(&layer)?)?))
-        })
-        .collect();
-    let start = guess.filter(|g| !g.is_empty()).map(|g| {
-        keys.iter()
-            .map(|key| {
-                key.and_then(|(layer, k)| {
-                    (0..GUESS_REACH).find_map(|down| g.get(&(layer - down, k)).copied())
-                })
-                .unwrap_or([0.0; 6])
-            })
-            .collect()
-    });
+    let keys = guess_keys(state, &analysed, &shell);
+    let start = guess
+        .filter(|g| !g.is_empty())
+        .map(|g| guess_start(&keys, g));
     let (b, mode, full, _) = shell_buckling_run(&shell, state.index, options, start)?;
     let mode = mode
         .into_iter()
@@ -256,26 +234,7 @@ fn shell_buckling_run(
     ),
     DesignError,
 > {
-    let fe_opts = kappe_fe::BucklingOptions {
-        modes: options.modes,
-        // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
-        // modelling error and saves Lanczos steps over the default 1e-10. A graded mesh is
-        // itself an approximation (≤ 1 %, `crate::analysis::graded`): there 1e-6 suffices, since a Ritz
-        // value with relative residual r lies within r (and, given the gap to the next mode,
-        // within ~r²) of an eigenvalue of the symmetric operator.
-        // With the mesh error controlled (0.5 % by default) 1e-5 is still 500 times below it
-        // (a Ritz value is within its relative residual of an eigenvalue).
-        tolerance: if options.converged_blf {
-            1e-5
-        } else if options.grading.is_some() {
-            1e-6
-        } else {
-            1e-8
-        },
-        sturm_check: options.sturm_check,
-        start,
-        ..Default::default()
-    };
+    let fe_opts = fe_options(options, start);
     let n = shell.model.nodes.len();
     match kappe_fe::buckling(&shell.model, &fe_opts) {
         Ok(r) => {
@@ -369,4 +328,113 @@ fn shell_buckling_run(
             message: format!("buckling analysis failed: {e}"),
         }),
     }
+}
+
+/// The eigen-solver options of a state's buckling solve (the print-layer mesh and its splits).
+fn fe_options(
+    options: &AnalysisOptions,
+    start: Option<Vec<[f64; 6]>>,
+) -> kappe_fe::BucklingOptions {
+    kappe_fe::BucklingOptions {
+        modes: options.modes,
+        // The BLF is compared with a calibrated threshold; 1e-8 relative is far below any
+        // modelling error and saves Lanczos steps over the default 1e-10. A graded mesh is
+        // itself an approximation (≤ 1 %, `crate::analysis::graded`): there 1e-6 suffices, since a Ritz
+        // value with relative residual r lies within r (and, given the gap to the next mode,
+        // within ~r²) of an eigenvalue of the symmetric operator.
+        // With the mesh error controlled (0.5 % by default) 1e-5 is still 500 times below it
+        // (a Ritz value is within its relative residual of an eigenvalue).
+        tolerance: if options.converged_blf {
+            1e-5
+        } else if options.grading.is_some() {
+            1e-6
+        } else {
+            1e-8
+        },
+        sturm_check: options.sturm_check,
+        start,
+        ..Default::default()
+    }
+}
+
+/// The [`ModeGuess`] key of every node of `shell` (a state's shell on `analysed`): (layer id,
+/// index of the node in its layer); `None` for a node without one.
+fn guess_keys(
+    state: &State,
+    analysed: &crate::analysis::graded::AnalysedState<'_>,
+    shell: &StateShell,
+) -> Vec<Option<(i32, usize)>> {
+    // First network index of every layer: the network stores each layer contiguously.
+    let mut first: HashMap<i32, usize> = HashMap::new();
+    for (i, n) in state.network.nodes.iter().enumerate() {
+        if n.role != crate::form::states::Role::ColumnEnd {
+            first.entry(n.layer).or_insert(i);
+        }
+    }
+    shell
+        .network_node
+        .iter()
+        .map(|&k| {
+            let i = analysed.full_index(k)?;
+            let layer = state.network.nodes.get(i)?.layer;
+            Some((layer, i.checked_sub(*first.get(&layer)?)?))
+        })
+        .collect()
+}
+
+/// A start vector per shell node (`keys`: [`guess_keys`]) from the mode `g`: a layer missing
+/// from `g` takes the nearest layer below it, a node without a key zero.
+fn guess_start(keys: &[Option<(i32, usize)>], g: &ModeGuess) -> Vec<[f64; 6]> {
+    keys.iter()
+        .map(|key| {
+            key.and_then(|(layer, k)| {
+                (0..GUESS_REACH).find_map(|down| g.get(&(layer - down, k)).copied())
+            })
+            .unwrap_or([0.0; 6])
+        })
+        .collect()
+}
+
+/// The mesh-error levels (`kappe_fe::converge_from`: the 2×2 split, and further up to
+/// `options.blf_max_split` while the error exceeds `blf_tolerance`) of a state whose
+/// print-layer mesh was already solved by [`state_buckling_warm`] with the same `material` and
+/// `options`: `coarse` is that solve's lowest factor and `mode` its mode 1 (the [`ModeGuess`] it
+/// returned), which starts the split's Lanczos. Solving the print-layer mesh again, from a cold
+/// start, cost the mesh-error pass about a sixth of its time (docs/convergence.md, "Speed").
+/// `None` when the state has no shell or the split has no positive factor.
+///
+/// # Errors
+/// A split mesh that cannot be solved.
+pub fn state_refine(
+    state: &State,
+    material: &ShellMaterial,
+    options: &AnalysisOptions,
+    coarse: f64,
+    mode: &ModeGuess,
+) -> Result<Option<kappe_fe::ConvergedFactor>, DesignError> {
+    let analysed = crate::analysis::graded::AnalysedState::new(state, options.grading.as_ref());
+    let Ok(shell) = state_shell(analysed.state(), material, options.row_stride) else {
+        return Ok(None);
+    };
+    let keys = guess_keys(state, &analysed, &shell);
+    let start = (!mode.is_empty()).then(|| guess_start(&keys, mode));
+    let fe_opts = fe_options(options, None);
+    let level = kappe_fe::MeshLevel {
+        split: 1,
+        factor: coarse,
+        n_free_dofs: 0,
+        steps: 0,
+    };
+    kappe_fe::converge_from(
+        &shell.model,
+        level,
+        start,
+        &fe_opts,
+        options.blf_tolerance,
+        options.blf_max_split,
+    )
+    .map_err(|e| DesignError::State {
+        state: state.index,
+        message: format!("buckling analysis of the refined mesh failed: {e}"),
+    })
 }

@@ -18,9 +18,11 @@ use crate::form::states::build_state;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 
-/// Consecutive states per warm-started run of the graded analysis: each run's first state
-/// starts cold, so longer runs save more Lanczos steps; shorter ones balance the cores better.
-const WARM_RUN: usize = 32;
+/// Consecutive states per warm-started run: each run's first state starts cold, so longer runs
+/// save more Lanczos steps; shorter ones balance the cores better. 16: the default cap's 113
+/// states in 8 runs instead of 4, so the last run no longer finishes alone (four more cold
+/// starts, about five Lanczos steps each).
+const WARM_RUN: usize = 16;
 
 /// The analysis of one print state.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -371,6 +373,41 @@ fn state_fe_with(
     })
 }
 
+/// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
+/// ([`state_fe`] without a green-state model): [`state_fe_with`] with `options`, without
+/// solving the print-layer mesh again. Only `buckling.convergence` and `seconds` are meant to be
+/// read ([`converge_fe`]'s solver).
+///
+/// # Errors
+/// A state that cannot be built or solved.
+fn state_fe_refine(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    top: usize,
+    coarse: f64,
+    mode: &ModeGuess,
+) -> Result<StateFe, DesignError> {
+    let t0 = Instant::now();
+    let phi = cap.design.print.start_arch_fraction;
+    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+    let mat = state_material_with(cap, options, top, None);
+    let convergence = super::buckling::state_refine(&state, &mat, options, coarse, mode)?;
+    Ok(StateFe {
+        state: top,
+        buckling: StateBuckling {
+            status: BucklingStatus::Analysed,
+            factors: vec![coarse],
+            location: None,
+            mechanism: None,
+            shell_nodes: 0,
+            convergence,
+        },
+        mode: Vec::new(),
+        green: None,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
 /// A solver of single states with given options (see [`converge_fe`]).
 pub type SolveStates<'a> =
     dyn FnMut(&[usize], &AnalysisOptions) -> Result<Vec<StateFe>, DesignError> + 'a;
@@ -581,6 +618,9 @@ pub(crate) fn analyze_scheduled(
     let t_phase = Instant::now();
     let runs = fe_runs(options, cap.states.len());
     let n_fe = runs.iter().map(Vec::len).sum();
+    // Each state's first-pass mode is kept (about 50 bytes a shell node) so the mesh-error pass
+    // continues from it instead of solving the print-layer mesh again (`state_refine`).
+    let first_modes = std::sync::Mutex::new(std::collections::HashMap::new());
     let fe: Vec<StateFe> = runs
         .into_par_iter()
         .map(|run| {
@@ -588,7 +628,13 @@ pub(crate) fn analyze_scheduled(
             let mut out = Vec::with_capacity(run.len());
             for top in run {
                 cancelled()?;
-                out.push(state_fe(cap, options, green.as_ref(), top, &mut guess)?);
+                let f = state_fe(cap, options, green.as_ref(), top, &mut guess)?;
+                if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first())
+                    && let Ok(mut m) = first_modes.lock()
+                {
+                    m.insert(top, (f1, g.clone()));
+                }
+                out.push(f);
                 on_state(n_fe);
             }
             Ok(out)
@@ -597,15 +643,31 @@ pub(crate) fn analyze_scheduled(
         .into_iter()
         .flatten()
         .collect();
+    let first_modes = first_modes.into_inner().unwrap_or_default();
     let mut fe = fe;
     let interpolated = converge_fe(options, &mut fe, &mut |states, opts| {
-        states
-            .par_iter()
-            .map(|&top| {
-                cancelled()?;
-                state_fe_with(cap, opts, green.as_ref(), top, &mut None)
+        // Largest state first, each core taking the next state as it finishes (longest
+        // processing time first): a batch of a few split meshes of very different sizes left a
+        // core idle behind the largest one under rayon's halving of the slice.
+        let mut order = states.to_vec();
+        order.sort_unstable_by(|a, b| b.cmp(a));
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let workers = rayon::current_num_threads().clamp(1, order.len().max(1));
+        let parts = (0..workers)
+            .into_par_iter()
+            .map(|_| {
+                let mut out = Vec::new();
+                while let Some(&top) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    cancelled()?;
+                    out.push(match first_modes.get(&top) {
+                        Some((f1, mode)) => state_fe_refine(cap, opts, top, *f1, mode),
+                        None => state_fe_with(cap, opts, green.as_ref(), top, &mut None),
+                    }?);
+                }
+                Ok(out)
             })
-            .collect()
+            .collect::<Result<Vec<_>, DesignError>>()?;
+        Ok(parts.into_iter().flatten().collect())
     })?;
     let wall_fe = t_phase.elapsed().as_secs_f64();
     assemble(

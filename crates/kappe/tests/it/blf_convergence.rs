@@ -100,3 +100,54 @@ fn sampled_states_match_every_state_solved() {
     }
     assert!(interpolated > 0, "the sample interpolates some states");
 }
+
+/// The mesh-error pass continues from the first pass's factor and mode
+/// (`buckling::state_refine`) instead of solving the print-layer mesh again: on state 40 of the
+/// default cap its split factor and estimate agree with a solve of both meshes from scratch.
+/// Tolerance 1e-4 relative: each factor meets a Lanczos residual of 1e-5 relative (a Ritz
+/// value lies within its relative residual of an eigenvalue), and the extrapolation 2λ_f − λ_c
+/// at most triples that (3e-5), rounded up.
+#[test]
+fn the_split_pass_continues_from_the_first_pass() {
+    use kappe::analysis::buckling::{state_buckling_mode, state_buckling_warm, state_refine};
+    let d = kappe::Design::default();
+    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
+    let o = AnalysisOptions::default();
+    let top = 40;
+    let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();
+    let mat = state_material(&cap, &o, top).unwrap();
+    let scratch = state_buckling_mode(&state, &mat, &o)
+        .unwrap()
+        .0
+        .convergence
+        .unwrap();
+    let first = AnalysisOptions {
+        blf_max_split: 1,
+        ..o.clone()
+    };
+    let (b, _, mode) = state_buckling_warm(&state, &mat, &first, None).unwrap();
+    assert!(
+        b.convergence.is_none(),
+        "the first pass solves the layer mesh only"
+    );
+    let split_opts = AnalysisOptions {
+        blf_max_split: 2,
+        ..o.clone()
+    };
+    let cont = state_refine(&state, &mat, &split_opts, b.factors[0], &mode)
+        .unwrap()
+        .unwrap();
+    assert_eq!(cont.levels.len(), 2);
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    assert!(
+        rel(cont.levels[1].factor, scratch.levels[1].factor) <= 1e-4,
+        "{cont:?} vs {scratch:?}"
+    );
+    assert!(
+        rel(cont.extrapolated, scratch.extrapolated) <= 1e-4,
+        "{cont:?} vs {scratch:?}"
+    );
+    // The split converged from the prolonged mode, not from a random start: fewer steps
+    // than the layer mesh's cold solve (16 on this state, examples/blf_phases.rs).
+    assert!(cont.levels[1].steps < 16, "{cont:?}");
+}
