@@ -7,6 +7,10 @@
 //! * `speed`: per layer count 10, 20, 30, 40: one LBA solve against one collapse path (best of
 //!   three), and `kappe buildability` of the 60-layer cylinder with the collapse check at every
 //!   layer (wall-clock, CPU).
+//! * `diag`: the 12-layer state (material check off, w0 = 0) on 24, 48, 96 segments and on
+//!   48 segments split 2×2: λ_LBA, the critical factor of the co-rotational tangent linearised
+//!   at the reference state (`kappe_fe::linearised_critical_factor`) and the perfect path's
+//!   bifurcation (docs/collapse.md §4, the λ_c → λ_LBA check).
 
 use std::time::Instant;
 
@@ -77,6 +81,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             failure(&r)?
         );
     }
+    if what == "diag" {
+        diag()?;
+    }
     if what == "speed" {
         let r = spec("", "")?;
         println!(
@@ -116,6 +123,60 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             load_average(),
             b.failure_layer
         );
+    }
+    Ok(())
+}
+
+/// The `diag` table (module docs).
+fn diag() -> Result<(), Box<dyn std::error::Error>> {
+    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, Linearisation, PathOptions, buckling, nonlinear_path};
+    let n = 12;
+    println!(
+        "  {:>4} {:>5} {:>7} {:>6} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6}",
+        "segs", "split", "DOFs", "local", "λ_LBA", "K_σ/LBA", "dK/LBA", "λ_path", "path/LBA", "LDLᵀ"
+    );
+    for (segs, split) in [(24, 1), (48, 1), (96, 1), (48, 2)] {
+        let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
+        let r = BuildabilitySpec::from_toml_str(&text)?;
+        let (mut model, layers) = object_shell(&r, n);
+        let ages = r.schedule.ages(n);
+        check_state(&mut model, &layers, &ages, &r.time, &GreenOptions::default())?;
+        let model = kappe_fe::refine::split(&model, split).model;
+        let lba = buckling(
+            &model,
+            &BucklingOptions {
+                modes: 1,
+                ..Default::default()
+            },
+        )?;
+        let l = lba.factors[0];
+        for local_geometric in [false, true] {
+            let lin = |which| -> Result<f64, Box<dyn std::error::Error>> {
+                Ok(kappe_fe::linearised_critical_factor(&model, l, 1e-5, which)?.lambda)
+            };
+            let sigma = lin(Linearisation::InitialStress { local_geometric })?;
+            let deriv = lin(Linearisation::Derivative { local_geometric })?;
+            let opt = PathOptions {
+                initial_increment: 0.5 * l,
+                lambda_max: 1.5 * l,
+                local_geometric,
+                ..Default::default()
+            };
+            let path =
+                nonlinear_path(&model, &opt, &mut |_| std::ops::ControlFlow::Continue(()))?;
+            let lp = path.limit.map_or(f64::NAN, |x| x.lambda);
+            println!(
+                "  {segs:>4} {split:>5} {:>7} {:>6} {l:>9.4} {:>9.4} {:>9.4} {lp:>9.4} {:>8.4} {:>6}",
+                6 * model.nodes.len(),
+                if local_geometric { "yes" } else { "no" },
+                sigma / l,
+                deriv / l,
+                lp / l,
+                path.stats.factorizations,
+            );
+        }
     }
     Ok(())
 }
