@@ -150,14 +150,29 @@ fn diag() -> Result<(), Box<dyn std::error::Error>> {
     let n = 12;
     println!(
         "  {:>4} {:>5} {:>7} {:>6} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6}",
-        "segs", "split", "DOFs", "local", "λ_LBA", "K_σ/LBA", "dK/LBA", "λ_path", "path/LBA", "LDLᵀ"
+        "segs",
+        "split",
+        "DOFs",
+        "local",
+        "λ_LBA",
+        "K_σ/LBA",
+        "dK/LBA",
+        "λ_path",
+        "path/LBA",
+        "LDLᵀ"
     );
     for (segs, split) in [(24, 1), (48, 1), (96, 1), (48, 2)] {
         let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
         let r = BuildabilitySpec::from_toml_str(&text)?;
         let (mut model, layers) = object_shell(&r, n);
         let ages = r.schedule.ages(n);
-        check_state(&mut model, &layers, &ages, &r.time, &GreenOptions::default())?;
+        check_state(
+            &mut model,
+            &layers,
+            &ages,
+            &r.time,
+            &GreenOptions::default(),
+        )?;
         let model = kappe_fe::refine::split(&model, split).model;
         let lba = buckling(
             &model,
@@ -179,8 +194,7 @@ fn diag() -> Result<(), Box<dyn std::error::Error>> {
                 local_geometric,
                 ..Default::default()
             };
-            let path =
-                nonlinear_path(&model, &opt, &mut |_| std::ops::ControlFlow::Continue(()))?;
+            let path = nonlinear_path(&model, &opt, &mut |_| std::ops::ControlFlow::Continue(()))?;
             let lp = path.limit.map_or(f64::NAN, |x| x.lambda);
             println!(
                 "  {segs:>4} {split:>5} {:>7} {:>6} {l:>9.4} {:>9.4} {:>9.4} {lp:>9.4} {:>8.4} {:>6}",
@@ -320,7 +334,13 @@ fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> 
     let r = BuildabilitySpec::from_toml_str(&text)?;
     let (mut model, layers) = object_shell(&r, n);
     let ages = r.schedule.ages(n);
-    check_state(&mut model, &layers, &ages, &r.time, &GreenOptions::default())?;
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+    )?;
     let dir = std::path::Path::new("target/ccx_collapse");
     std::fs::create_dir_all(dir)?;
     let lba = buckling(
@@ -334,7 +354,10 @@ fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> 
     let (a, b) = kappe_fe::ccx::two_pass(dir, "buckle", |scale| {
         ccx_deck(&model, scale, "*STEP\n*BUCKLE\n2, 1e-6\n")
     })?;
-    let ccx_l = b.or(Some(a)).and_then(|x| x.1.first().copied()).unwrap_or(f64::NAN);
+    let ccx_l = b
+        .or(Some(a))
+        .and_then(|x| x.1.first().copied())
+        .unwrap_or(f64::NAN);
     println!(
         "  {segs} segments, {n} layers: λ_LBA Kappe {l:.4}, ccx S6 *BUCKLE {ccx_l:.4} ({:+.2} %)",
         100.0 * (ccx_l / l - 1.0)

@@ -96,7 +96,10 @@ pub fn linearised_critical_factor(
         Linearisation::Derivative { .. } => {
             let kp = tangent_at(h)?;
             let km = tangent_at(-h)?;
-            kp.iter().zip(&km).map(|(a, b)| (a - b) / (2.0 * h)).collect()
+            kp.iter()
+                .zip(&km)
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect()
         }
         Linearisation::InitialStress { .. } => {
             let mut u = vec![0.0; 6 * model.nodes.len()];
@@ -109,8 +112,7 @@ pub fn linearised_critical_factor(
     let mut count = |lam: f64| -> Result<usize, FeError> {
         factorizations += 1;
         let vals: Vec<f64> = k0.sym.iter().zip(&kg).map(|(k, g)| k + lam * g).collect();
-        Ok(p
-            .symbolic
+        Ok(p.symbolic
             .ldlt(&p.pattern, &vals)?
             .map_or(usize::MAX, |f| f.negative))
     };

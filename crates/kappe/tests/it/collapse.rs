@@ -76,7 +76,14 @@ fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
     let r = BuildabilitySpec::from_toml_str(EXAMPLE_TOML).unwrap();
     let (mut model, layers) = object_shell(&r, n);
     let ages = r.schedule.ages(n);
-    check_state(&mut model, &layers, &ages, &r.time, &GreenOptions::default()).unwrap();
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+    )
+    .unwrap();
     let model = kappe_fe::refine::split(&model, 2).model;
     let lba = buckling(
         &model,
