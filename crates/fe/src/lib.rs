@@ -65,8 +65,8 @@ pub use convergence::{ConvergedFactor, MeshLevel, converge_factor, converge_from
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use nonlinear::{
-    Path, PathControl, PathOptions, PathStep, StopReason, deformed_resultants, nonlinear_path,
-    with_imperfection,
+    Linearisation, LinearisedCritical, Path, PathControl, PathOptions, PathStep, StopReason,
+    deformed_resultants, linearised_critical_factor, nonlinear_path, with_imperfection,
 };
 pub use solver::{
     BucklingOptions, BucklingResult, BucklingSolver, ElementResult, SolveStats, StaticResult,

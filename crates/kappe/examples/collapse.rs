@@ -7,6 +7,16 @@
 //! * `speed`: per layer count 10, 20, 30, 40: one LBA solve against one collapse path (best of
 //!   three), and `kappe buildability` of the 60-layer cylinder with the collapse check at every
 //!   layer (wall-clock, CPU).
+//! * `diag`: the 12-layer state (material check off, w0 = 0) on 24, 48, 96 segments and on
+//!   48 segments split 2×2: λ_LBA, the critical factor of the co-rotational tangent linearised
+//!   at the reference state (`kappe_fe::linearised_critical_factor`) and the perfect path's
+//!   bifurcation (docs/collapse.md §4, the λ_c → λ_LBA check).
+//! * `ccx [SEGMENTS] [LAYERS]`: the same state (default 48 segments, 12 layers) in CalculiX
+//!   (needs `ccx` on PATH; checking only): S6 triangles on our facets (mid-side nodes on the
+//!   straight edges), per-layer aged moduli, the base nodes' translations held; `*BUCKLE`, and
+//!   `*STATIC, NLGEOM` (load control with automatic increments: the last converged load is
+//!   the limit point, to the increment) on the perfect model and with our first mode as
+//!   imperfection, w0 = 0.2 and 2 mm; next to Kappe's λ_LBA and collapse factors.
 
 use std::time::Instant;
 
@@ -77,6 +87,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             failure(&r)?
         );
     }
+    if what == "diag" {
+        diag()?;
+    }
+    if what == "ccx" {
+        let arg = |i: usize, d: usize| {
+            std::env::args()
+                .nth(i)
+                .and_then(|v| v.parse().ok())
+                .unwrap_or(d)
+        };
+        ccx_compare(arg(2, 48), arg(3, 12))?;
+    }
     if what == "speed" {
         let r = spec("", "")?;
         println!(
@@ -115,6 +137,249 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cpu_seconds().zip(c0).map_or(f64::NAN, |(a, b)| a - b),
             load_average(),
             b.failure_layer
+        );
+    }
+    Ok(())
+}
+
+/// The `diag` table (module docs).
+fn diag() -> Result<(), Box<dyn std::error::Error>> {
+    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, Linearisation, PathOptions, buckling, nonlinear_path};
+    let n = 12;
+    println!(
+        "  {:>4} {:>5} {:>7} {:>6} {:>9} {:>9} {:>9} {:>9} {:>8} {:>6}",
+        "segs",
+        "split",
+        "DOFs",
+        "local",
+        "λ_LBA",
+        "K_σ/LBA",
+        "dK/LBA",
+        "λ_path",
+        "path/LBA",
+        "LDLᵀ"
+    );
+    for (segs, split) in [(24, 1), (48, 1), (96, 1), (48, 2)] {
+        let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
+        let r = BuildabilitySpec::from_toml_str(&text)?;
+        let (mut model, layers) = object_shell(&r, n);
+        let ages = r.schedule.ages(n);
+        check_state(
+            &mut model,
+            &layers,
+            &ages,
+            &r.time,
+            &GreenOptions::default(),
+        )?;
+        let model = kappe_fe::refine::split(&model, split).model;
+        let lba = buckling(
+            &model,
+            &BucklingOptions {
+                modes: 1,
+                ..Default::default()
+            },
+        )?;
+        let l = lba.factors[0];
+        for local_geometric in [false, true] {
+            let lin = |which| -> Result<f64, Box<dyn std::error::Error>> {
+                Ok(kappe_fe::linearised_critical_factor(&model, l, 1e-5, which)?.lambda)
+            };
+            let sigma = lin(Linearisation::InitialStress { local_geometric })?;
+            let deriv = lin(Linearisation::Derivative { local_geometric })?;
+            let opt = PathOptions {
+                initial_increment: 0.5 * l,
+                lambda_max: 1.5 * l,
+                local_geometric,
+                ..Default::default()
+            };
+            let path = nonlinear_path(&model, &opt, &mut |_| std::ops::ControlFlow::Continue(()))?;
+            let lp = path.limit.map_or(f64::NAN, |x| x.lambda);
+            println!(
+                "  {segs:>4} {split:>5} {:>7} {:>6} {l:>9.4} {:>9.4} {:>9.4} {lp:>9.4} {:>8.4} {:>6}",
+                6 * model.nodes.len(),
+                if local_geometric { "yes" } else { "no" },
+                sigma / l,
+                deriv / l,
+                lp / l,
+                path.stats.factorizations,
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A ccx deck of `m` as S6 (mid-side nodes on the straight facet edges), one material and
+/// shell section per distinct modulus, base translations held, self-weight along
+/// `m.gravity` times `scale`, and `step` (the keyword lines of the step).
+fn ccx_deck(m: &kappe_fe::ShellModel, scale: f64, step: &str) -> String {
+    use kappe_fe::ccx;
+    use std::collections::HashMap;
+    use std::fmt::Write as _;
+    let mut s = String::from("*HEADING\nstate\n");
+    let mut nodes = m.nodes.clone();
+    let fixed = m.fixed_mask();
+    let mut held: Vec<bool> = fixed.iter().map(|f| f[0] && f[1] && f[2]).collect();
+    // A clamped base holds the rotations too (ccx's shell node rotations: 4–6, a knot).
+    let clamped = fixed.iter().any(|f| f[3] && f[4] && f[5]);
+    let mut mid: HashMap<(usize, usize), usize> = HashMap::new();
+    let mut elems = Vec::new();
+    for t in &m.triangles {
+        let mut e = vec![t[0], t[1], t[2]];
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let id = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (nodes[a], nodes[b]);
+                nodes.push([
+                    0.5 * (p[0] + q[0]),
+                    0.5 * (p[1] + q[1]),
+                    0.5 * (p[2] + q[2]),
+                ]);
+                held.push(held[a] && held[b]);
+                nodes.len() - 1
+            });
+            e.push(id);
+        }
+        elems.push(e);
+    }
+    ccx::write_nodes(&mut s, &nodes);
+    ccx::write_elements(
+        &mut s,
+        "S6",
+        elems.iter().map(|e| e.iter().map(|n| n + 1).collect()),
+    );
+    let mut groups: Vec<(kappe_fe::Material, Vec<usize>)> = Vec::new();
+    for e in 0..m.triangles.len() {
+        let mat = m.material_of(e);
+        match groups.iter_mut().find(|g| g.0 == mat) {
+            Some(g) => g.1.push(e + 1),
+            None => groups.push((mat, vec![e + 1])),
+        }
+    }
+    ccx::write_supports(&mut s, (0..nodes.len()).filter(|&n| held[n]).map(|n| n + 1));
+    s.push_str(if clamped {
+        "*BOUNDARY\nSUP, 1, 6\n"
+    } else {
+        "*BOUNDARY\nSUP, 1, 3\n"
+    });
+    let t = m.thickness_of(0);
+    for (k, (mat, ids)) in groups.iter().enumerate() {
+        let _ = writeln!(s, "*ELSET, ELSET=E{k}");
+        for c in ids.chunks(10) {
+            let v: Vec<String> = c.iter().map(usize::to_string).collect();
+            let _ = writeln!(s, "{}", v.join(", "));
+        }
+        let _ = write!(
+            s,
+            "*MATERIAL, NAME=M{k}\n*ELASTIC\n{:e}, {}\n*DENSITY\n{:e}\n\
+             *SHELL SECTION, ELSET=E{k}, MATERIAL=M{k}\n{t}\n",
+            mat.youngs_modulus,
+            mat.poisson_ratio,
+            mat.unit_weight / ccx::GRAVITY
+        );
+    }
+    let g = m.gravity;
+    let gn = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    let _ = write!(
+        s,
+        "{step}*DLOAD\nEALL, GRAV, {:.8e}, {}, {}, {}\n*END STEP\n",
+        ccx::GRAVITY * gn * scale,
+        g[0] / gn,
+        g[1] / gn,
+        g[2] / gn
+    );
+    s
+}
+
+/// The limit load factor of a ccx NLGEOM run under `lam_max` × self-weight: the total time
+/// of the last converged increment in the `.sta` file times `lam_max`, and the wall time.
+fn ccx_limit(
+    dir: &std::path::Path,
+    job: &str,
+    m: &kappe_fe::ShellModel,
+    lam_max: f64,
+) -> Result<(f64, f64, usize), Box<dyn std::error::Error>> {
+    let step = "*STEP, NLGEOM, INC=2000\n*STATIC\n0.05, 1.0, 1e-7, 0.05\n";
+    std::fs::write(dir.join(format!("{job}.inp")), ccx_deck(m, lam_max, step))?;
+    let t0 = Instant::now();
+    std::process::Command::new("ccx")
+        .arg(job)
+        .current_dir(dir)
+        .env("OMP_NUM_THREADS", "1")
+        .stdout(std::process::Stdio::null())
+        .status()?;
+    let wall = t0.elapsed().as_secs_f64();
+    let sta = std::fs::read_to_string(dir.join(format!("{job}.sta")))?;
+    let mut last = 0.0;
+    let mut incs = 0;
+    for line in sta.lines() {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|x| x.parse().ok())
+            .collect();
+        if v.len() >= 7 {
+            last = v[4];
+            incs += 1;
+        }
+    }
+    Ok((last * lam_max, wall, incs))
+}
+
+/// The `ccx` table (module docs).
+fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> {
+    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, PathOptions, buckling, nonlinear_path, with_imperfection};
+    let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
+    let r = BuildabilitySpec::from_toml_str(&text)?;
+    let (mut model, layers) = object_shell(&r, n);
+    let ages = r.schedule.ages(n);
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+    )?;
+    let dir = std::path::Path::new("target/ccx_collapse");
+    std::fs::create_dir_all(dir)?;
+    let lba = buckling(
+        &model,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )?;
+    let l = lba.factors[0];
+    let (a, b) = kappe_fe::ccx::two_pass(dir, "buckle", |scale| {
+        ccx_deck(&model, scale, "*STEP\n*BUCKLE\n2, 1e-6\n")
+    })?;
+    let ccx_l = b
+        .or(Some(a))
+        .and_then(|x| x.1.first().copied())
+        .unwrap_or(f64::NAN);
+    println!(
+        "  {segs} segments, {n} layers: λ_LBA Kappe {l:.4}, ccx S6 *BUCKLE {ccx_l:.4} ({:+.2} %)",
+        100.0 * (ccx_l / l - 1.0)
+    );
+    println!(
+        "  {:>8} {:>10} {:>10} {:>8} {:>10} {:>6}",
+        "w0 [mm]", "Kappe λ_c", "ccx λ_c", "ccx/K", "ccx [s]", "incs"
+    );
+    for w0 in [0.0, 0.2e-3, 2e-3] {
+        let imp = with_imperfection(&model, &lba.modes[0], w0)?;
+        let opt = PathOptions {
+            initial_increment: 0.5 * l,
+            lambda_max: 1.5 * l,
+            ..Default::default()
+        };
+        let path = nonlinear_path(&imp, &opt, &mut |_| std::ops::ControlFlow::Continue(()))?;
+        let lk = path.limit.map_or(f64::NAN, |x| x.lambda);
+        let (lc, wall, incs) = ccx_limit(dir, "nlgeom", &imp, 1.5 * l)?;
+        println!(
+            "  {:>8.2} {lk:>10.4} {lc:>10.4} {:>8.4} {wall:>10.1} {incs:>6}",
+            w0 * 1e3,
+            lc / lk
         );
     }
     Ok(())

@@ -195,6 +195,147 @@ pub(crate) fn frame_of(p: &[Vector3<f64>; 3]) -> Matrix3<f64> {
     Matrix3::from_rows(&[e1.transpose(), e2.transpose(), e3.transpose()])
 }
 
+/// The facet's own initial-stress (von Kármán) terms in its local frame: membrane forces
+/// `N = C d̄` and the linear element's geometric stiffness per unit membrane force,
+/// `K̄_G(N) = Σ_k N_k G_k` (the same matrix the linear buckling solver assembles), kept as
+/// its in-plane 3×3 block (acting on u and v alike) and its 9×9 block on the plate DOFs.
+#[derive(Debug, Clone)]
+pub(crate) struct LocalGeometric {
+    c: SMatrix<f64, 3, 18>,
+    /// `D_m / (2A)`: membrane force per unit `q = [d̄ᵀG_k d̄]` (the mean von Kármán strain is
+    /// `q / 2A`).
+    dq: Matrix3<f64>,
+    kuu: [Matrix3<f64>; 3],
+    kb: [SMatrix<f64, 9, 9>; 3],
+}
+
+/// Plate DOFs (w, θx, θy) of the 18 local ones.
+const BEND: [usize; 9] = [2, 3, 4, 8, 9, 10, 14, 15, 16];
+
+impl LocalGeometric {
+    /// From the element's global geometric stiffness per unit `N_k` and its membrane forces
+    /// per unit local DOF (both on the initial geometry, rotated into its frame).
+    pub(crate) fn new(
+        frame0: &[[f64; 3]; 3],
+        area: f64,
+        membrane_rigidity: Matrix3<f64>,
+        geometric: impl Fn(&[f64; 3]) -> Mat18,
+        membrane: impl Fn(&[f64; 18]) -> [f64; 3],
+    ) -> Self {
+        let t0 = Matrix3::from_fn(|i, j| frame0[i][j]);
+        let mut c = SMatrix::<f64, 3, 18>::zeros();
+        for j in 0..18 {
+            let (blk, i) = (j / 3, j % 3);
+            let mut ug = [0.0; 18];
+            for r in 0..3 {
+                ug[3 * blk + r] = t0[(i, r)];
+            }
+            let n = membrane(&ug);
+            for k in 0..3 {
+                c[(k, j)] = n[k];
+            }
+        }
+        let mut kuu = [Matrix3::zeros(); 3];
+        let mut kb = [SMatrix::<f64, 9, 9>::zeros(); 3];
+        for k in 0..3 {
+            let mut unit = [0.0; 3];
+            unit[k] = 1.0;
+            let kl = to_local18(&geometric(&unit), &t0);
+            kuu[k] = Matrix3::from_fn(|a, b| kl[(6 * a, 6 * b)]);
+            kb[k] = SMatrix::<f64, 9, 9>::from_fn(|a, b| kl[(BEND[a], BEND[b])]);
+        }
+        Self {
+            c,
+            dq: membrane_rigidity / (2.0 * area),
+            kuu,
+            kb,
+        }
+    }
+
+    /// `K̄_G(n)` as a local 18×18 matrix.
+    pub(crate) fn matrix(&self, n: &[f64; 3]) -> Mat18 {
+        let mut out = Mat18::zeros();
+        let kuu = self.kuu[0] * n[0] + self.kuu[1] * n[1] + self.kuu[2] * n[2];
+        let kb = self.kb[0] * n[0] + self.kb[1] * n[1] + self.kb[2] * n[2];
+        for a in 0..3 {
+            for b in 0..3 {
+                out[(6 * a, 6 * b)] = kuu[(a, b)];
+                out[(6 * a + 1, 6 * b + 1)] = kuu[(a, b)];
+            }
+        }
+        for (i, &gi) in BEND.iter().enumerate() {
+            for (j, &gj) in BEND.iter().enumerate() {
+                out[(gi, gj)] = kb[(i, j)];
+            }
+        }
+        out
+    }
+
+    /// `ΔN = D_m q / 2A`: the membrane force of the mean von Kármán strain of the slopes.
+    pub(crate) fn slope_membrane_force(&self, d: &Vec18) -> [f64; 3] {
+        let gd = self.g_times(d);
+        let q = Vector3::new(d.dot(&gd[0]), d.dot(&gd[1]), d.dot(&gd[2]));
+        let dn = self.dq * q;
+        [dn[0], dn[1], dn[2]]
+    }
+
+    /// `G_k d` for k = 0, 1, 2.
+    fn g_times(&self, d: &Vec18) -> [Vec18; 3] {
+        let db = SVector::<f64, 9>::from_fn(|i, _| d[BEND[i]]);
+        std::array::from_fn(|k| {
+            let mut out = Vec18::zeros();
+            for a in 0..3 {
+                for b in 0..3 {
+                    out[6 * a] += self.kuu[k][(a, b)] * d[6 * b];
+                    out[6 * a + 1] += self.kuu[k][(a, b)] * d[6 * b + 1];
+                }
+            }
+            let kd = self.kb[k] * db;
+            for (i, &gi) in BEND.iter().enumerate() {
+                out[gi] += kd[i];
+            }
+            out
+        })
+    }
+
+    /// Force and tangent of the facet's von Kármán energy beyond `½ d̄ᵀK̄d̄`, with the
+    /// membrane strain of the slopes taken as its element mean `q / 2A`,
+    /// `q_k = d̄ᵀ G_k d̄`, and `N = C d̄`, `ΔN = D_m q / 2A`:
+    /// `Π = ½ Nᵀq + qᵀ D_m q / 8A`,
+    /// `f = Σ (N_k + ΔN_k) G_k d̄ + ½ Σ c_k q_k`,
+    /// `K = Σ (N_k + ΔN_k) G_k + Σ (G_k d̄ c_kᵀ + c_k d̄ᵀ G_k) + 2 Σ_kj (D_m/2A)_kj G_k d̄ d̄ᵀ G_j`.
+    fn force_tangent(&self, d: &Vec18) -> (Vec18, Mat18) {
+        let n = self.c * d;
+        let gd = self.g_times(d);
+        let q = Vector3::new(d.dot(&gd[0]), d.dot(&gd[1]), d.dot(&gd[2]));
+        let nt = n + self.dq * q;
+        let mut f = Vec18::zeros();
+        let mut k = self.matrix(&[nt[0], nt[1], nt[2]]);
+        for kk in 0..3 {
+            let ck = self.c.row(kk).transpose();
+            f += gd[kk] * nt[kk] + ck * (0.5 * q[kk]);
+            k += gd[kk] * ck.transpose() + ck * gd[kk].transpose();
+            for j in 0..3 {
+                k += gd[kk] * gd[j].transpose() * (2.0 * self.dq[(kk, j)]);
+            }
+        }
+        (f, k)
+    }
+}
+
+/// `T₀ K T₀ᵀ` block by block (global → local).
+fn to_local18(k: &Mat18, t0: &Matrix3<f64>) -> Mat18 {
+    let mut out = Mat18::zeros();
+    for a in 0..6 {
+        for b in 0..6 {
+            let blk = k.fixed_view::<3, 3>(3 * a, 3 * b).into_owned();
+            out.fixed_view_mut::<3, 3>(3 * a, 3 * b)
+                .copy_from(&(t0 * blk * t0.transpose()));
+        }
+    }
+    out
+}
+
 /// The co-rotational wrapper of one element: its linear stiffness in the initial local frame
 /// and the initial local node coordinates.
 #[derive(Debug, Clone)]
@@ -205,6 +346,8 @@ pub(crate) struct CrElement {
     frame0: Matrix3<f64>,
     /// Initial local coordinates relative to the centroid.
     xbar0: [Vector3<f64>; 3],
+    /// The facet's local initial-stress terms (`None`: the plain small-strain EICR facet).
+    local: Option<LocalGeometric>,
 }
 
 /// Deformational state of one element.
@@ -219,22 +362,20 @@ pub(crate) struct Kinematics {
 
 impl CrElement {
     /// From the initial geometry and the element's global linear stiffness on it.
-    pub(crate) fn new(geo: &TriangleGeometry, k_global: &Mat18) -> Self {
+    pub(crate) fn new(
+        geo: &TriangleGeometry,
+        k_global: &Mat18,
+        local: Option<LocalGeometric>,
+    ) -> Self {
         let frame0 = Matrix3::from_fn(|i, j| geo.frame[i][j]);
-        let mut kbar = Mat18::zeros();
-        for a in 0..6 {
-            for b in 0..6 {
-                let blk = k_global.fixed_view::<3, 3>(3 * a, 3 * b).into_owned();
-                kbar.fixed_view_mut::<3, 3>(3 * a, 3 * b)
-                    .copy_from(&(frame0 * blk * frame0.transpose()));
-            }
-        }
+        let kbar = to_local18(k_global, &frame0);
         let p: [Vector3<f64>; 3] = std::array::from_fn(|a| Vector3::new(geo.x[a], geo.y[a], 0.0));
         let c = (p[0] + p[1] + p[2]) / 3.0;
         Self {
             kbar,
             frame0,
             xbar0: p.map(|v| v - c),
+            local,
         }
     }
 
@@ -253,6 +394,11 @@ impl CrElement {
             }
         }
         Kinematics { tn, xbar, d }
+    }
+
+    /// The facet's local initial-stress terms, if it has them.
+    pub(crate) fn local(&self) -> Option<&LocalGeometric> {
+        self.local.as_ref()
     }
 
     /// Deformational displacements in the initial global axes (`T₀ᵀ d̄` per block), the input
@@ -276,8 +422,60 @@ impl CrElement {
         r: &[&Matrix3<f64>; 3],
         tangent: bool,
     ) -> (Vec18, Option<Mat18>) {
+        self.force_tangent_with(x, r, tangent, None)
+    }
+
+    /// The initial-stress stiffness of the facet on the current geometry (at the reference
+    /// state: x = X, R = I) for the stresses of the local deformational DOFs `d_lin`: the
+    /// tangent's terms linear in the element forces, without the material term `K̄`.
+    pub(crate) fn initial_stress_stiffness(
+        &self,
+        x: &[Vector3<f64>; 3],
+        r: &[&Matrix3<f64>; 3],
+        d_lin: &Vec18,
+    ) -> Mat18 {
+        self.force_tangent_with(x, r, true, Some(d_lin))
+            .1
+            .unwrap_or_else(Mat18::zeros)
+    }
+
+    /// Local deformational DOFs of a small global displacement `u` (18, element order) on
+    /// the initial geometry: `T₀ u` per block (the rigid part is annihilated by `K̄`, `C`).
+    pub(crate) fn local_of(&self, u: &Vec18) -> Vec18 {
+        let mut out = Vec18::zeros();
+        for blk in 0..6 {
+            let v = self.frame0 * Vector3::new(u[3 * blk], u[3 * blk + 1], u[3 * blk + 2]);
+            for i in 0..3 {
+                out[3 * blk + i] = v[i];
+            }
+        }
+        out
+    }
+
+    /// [`Self::force_tangent`]; with `stress_of = Some(d)`, the stresses are those of `d`
+    /// and the material term is left out ([`Self::initial_stress_stiffness`]).
+    fn force_tangent_with(
+        &self,
+        x: &[Vector3<f64>; 3],
+        r: &[&Matrix3<f64>; 3],
+        tangent: bool,
+        stress_of: Option<&Vec18>,
+    ) -> (Vec18, Option<Mat18>) {
         let k = self.kinematics(x, r);
-        let fbar = self.kbar * k.d;
+        let (fbar, ktan) = match (stress_of, &self.local) {
+            (None, None) => (self.kbar * k.d, self.kbar),
+            (None, Some(l)) => {
+                let (fg, kg) = l.force_tangent(&k.d);
+                (self.kbar * k.d + fg, self.kbar + kg)
+            }
+            (Some(d), local) => {
+                let kg = local.as_ref().map_or_else(Mat18::zeros, |l| {
+                    let n = l.c * d;
+                    l.matrix(&[n[0], n[1], n[2]])
+                });
+                (self.kbar * d, kg)
+            }
+        };
         let theta: [Vector3<f64>; 3] =
             std::array::from_fn(|a| Vector3::new(k.d[6 * a + 3], k.d[6 * a + 4], k.d[6 * a + 5]));
         let hs: [Matrix3<f64>; 3] = std::array::from_fn(|a| h_matrix(&theta[a]));
@@ -328,9 +526,9 @@ impl CrElement {
             return (f, None);
         }
         // K̄ H (H mixes the rotation columns), then C = K̄ H P.
-        let mut kh = self.kbar;
+        let mut kh = ktan;
         for a in 0..3 {
-            let cols = self.kbar.fixed_view::<18, 3>(0, 6 * a + 3).into_owned();
+            let cols = ktan.fixed_view::<18, 3>(0, 6 * a + 3).into_owned();
             kh.fixed_view_mut::<18, 3>(0, 6 * a + 3)
                 .copy_from(&(cols * hs[a]));
         }
@@ -387,7 +585,7 @@ mod tests {
         };
         let k = CstDkt.stiffness(&geo, 0.05, &m, 1e-3);
         (
-            CrElement::new(&geo, &k),
+            CrElement::new(&geo, &k, None),
             p0.map(|p| Vector3::new(p[0], p[1], p[2])),
         )
     }

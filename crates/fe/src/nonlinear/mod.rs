@@ -38,7 +38,10 @@
 //! the linear solvers; the symbolic step is done once per path.
 
 pub mod corotational;
+mod linearised;
 mod path;
+
+pub use linearised::{Linearisation, LinearisedCritical, linearised_critical_factor};
 
 pub use path::{
     LimitKind, LimitPoint, Path, PathControl, PathOptions, PathStats, PathStep, StopReason,
@@ -53,7 +56,7 @@ use crate::element::ShellElement;
 use crate::error::FeError;
 use crate::model::ShellModel;
 use crate::solver::ElementResult;
-use corotational::{CrElement, Vec18, rot_exp, rot_log};
+use corotational::{CrElement, LocalGeometric, Vec18, rot_exp, rot_log};
 
 /// Node positions and rotations of a configuration.
 #[derive(Debug, Clone)]
@@ -145,15 +148,30 @@ pub(crate) struct Problem<'m> {
     pub(crate) has_moments: bool,
 }
 
-fn co_rotational_elements(model: &ShellModel) -> Vec<CrElement> {
+/// The co-rotational facets; `local`: with their own initial-stress terms
+/// ([`corotational::LocalGeometric`], docs/nonlinear.md).
+fn co_rotational_elements(model: &ShellModel, local: bool) -> Vec<CrElement> {
     let geo = geometries(model);
     let el: Box<dyn ShellElement> = model.element.implementation();
     let alpha = model.drilling_alpha;
     (0..model.triangles.len())
         .into_par_iter()
         .map(|e| {
-            let k = el.stiffness(&geo[e], model.thickness_of(e), &model.material_of(e), alpha);
-            CrElement::new(&geo[e], &k)
+            let (t, mat) = (model.thickness_of(e), model.material_of(e));
+            let k = el.stiffness(&geo[e], t, &mat, alpha);
+            let lg = local.then(|| {
+                let (e_t, nu) = (mat.youngs_modulus * t, mat.poisson_ratio);
+                let dm = Matrix3::new(1.0, nu, 0.0, nu, 1.0, 0.0, 0.0, 0.0, 0.5 * (1.0 - nu))
+                    * (e_t / (1.0 - nu * nu));
+                LocalGeometric::new(
+                    &geo[e].frame,
+                    geo[e].area,
+                    dm,
+                    |n| el.geometric_stiffness(&geo[e], t, &mat, n),
+                    |u| el.resultants(&geo[e], t, &mat, u).membrane,
+                )
+            });
+            CrElement::new(&geo[e], &k, lg)
         })
         .collect()
 }
@@ -162,6 +180,7 @@ impl<'m> Problem<'m> {
     pub(crate) fn new(
         model: &'m ShellModel,
         rotation_length: Option<f64>,
+        local_geometric: bool,
     ) -> Result<Self, FeError> {
         model.validate()?;
         let dofs = DofMap::new(model);
@@ -203,7 +222,7 @@ impl<'m> Problem<'m> {
             dofs,
             pattern,
             symbolic,
-            elements: co_rotational_elements(model),
+            elements: co_rotational_elements(model, local_geometric),
             q,
             weight,
             has_moments: model
@@ -261,6 +280,31 @@ impl<'m> Problem<'m> {
         }
         let f = self.dofs.free.iter().map(|&g| fg[g]).collect();
         Ok((f, kv))
+    }
+
+    /// The assembled initial-stress stiffness (symmetric part, lower values) on the
+    /// undeformed geometry for the element stresses of the global displacement `u` (6 per
+    /// node, all DOFs): see [`CrElement::initial_stress_stiffness`].
+    pub(crate) fn initial_stress(&self, u: &[f64]) -> Result<Vec<f64>, FeError> {
+        let model = self.model;
+        let st = State::initial(model);
+        let mut vals = vec![0.0; self.pattern.nnz()];
+        let ks: Vec<crate::element::Mat18> = (0..model.triangles.len())
+            .into_par_iter()
+            .map(|e| {
+                let t = &model.triangles[e];
+                let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
+                let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
+                let ue = Vec18::from_fn(|i, _| u[6 * t[i / 6] + i % 6]);
+                let el = &self.elements[e];
+                let k = el.initial_stress_stiffness(&x, &r, &el.local_of(&ue));
+                (k + k.transpose()) * 0.5
+            })
+            .collect();
+        for (e, k) in ks.iter().enumerate() {
+            scatter(model, &self.dofs, &self.pattern, e, k, &mut vals)?;
+        }
+        Ok(vals)
     }
 
     /// Apply a free-DOF increment: translations add, rotations `R ← exp(spin Δω) R`.
@@ -341,8 +385,9 @@ pub fn with_imperfection(
 
 /// Element results in a deformed state given by `displacements` (e.g.
 /// [`PathStep::displacements`]): membrane forces, moments and stresses from the
-/// deformational displacements (small strains), each in the element's **current** frame
-/// (rows e₁, e₂, e₃ of the deformed facet).
+/// deformational displacements (small strains; the membrane forces include the facet's mean
+/// von Kármán strain of its local slopes, as in the path's facets), each in the element's
+/// **current** frame (rows e₁, e₂, e₃ of the deformed facet).
 pub fn deformed_resultants(
     model: &ShellModel,
     displacements: &[[f64; 6]],
@@ -356,25 +401,31 @@ pub fn deformed_resultants(
         });
     }
     let st = State::from_displacements(model, displacements);
-    let geo = geometries(model);
     let el: Box<dyn ShellElement> = model.element.implementation();
-    let alpha = model.drilling_alpha;
+    let geo = geometries(model);
+    let crs = co_rotational_elements(model, true);
     Ok(model
         .triangles
         .par_iter()
+        .zip(&crs)
         .enumerate()
-        .map(|(e, t)| {
+        .map(|(e, (t, cr))| {
             let (th, mat) = (model.thickness_of(e), model.material_of(e));
-            let k = el.stiffness(&geo[e], th, &mat, alpha);
-            let cr = CrElement::new(&geo[e], &k);
             let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
             let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
             let kin = cr.kinematics(&x, &r);
             let dg = cr.deformational_global(&kin);
             let tn = kin.tn;
+            let mut resultants = el.resultants(&geo[e], th, &mat, &dg);
+            if let Some(l) = cr.local() {
+                let dn = l.slope_membrane_force(&kin.d);
+                for (n, d) in resultants.membrane.iter_mut().zip(dn) {
+                    *n += d;
+                }
+            }
             ElementResult {
                 frame: std::array::from_fn(|i| [tn[(i, 0)], tn[(i, 1)], tn[(i, 2)]]),
-                resultants: el.resultants(&geo[e], th, &mat, &dg),
+                resultants,
                 thickness: th,
             }
         })
@@ -416,7 +467,7 @@ mod tests {
             force: [0.0; 3],
             moment: [0.0, -1.0, 0.0],
         }];
-        let p = Problem::new(&m, None).unwrap();
+        let p = Problem::new(&m, None, true).unwrap();
         let nf = p.dofs.n_free();
         let mut st = State::initial(&m);
         // A large bending rotation: each node i rotated by −θ·x about y, placed on the arc.

@@ -66,6 +66,11 @@ pub struct PathOptions {
     /// Length ℓ weighting rotations in the arc-length norm (rotation·ℓ ≈ a translation);
     /// `None` (default): the mean edge length of the mesh.
     pub rotation_length: Option<f64>,
+    /// Give each facet its own initial-stress (von Kármán) terms in its co-rotated frame, so
+    /// that the tangent at the reference state carries the linear buckling solver's K_G
+    /// (docs/nonlinear.md, "Local initial-stress terms"). Default true; false is the plain
+    /// small-strain EICR facet (kept for comparison).
+    pub local_geometric: bool,
 }
 
 impl Default for PathOptions {
@@ -84,6 +89,7 @@ impl Default for PathOptions {
             stop_at_limit: true,
             modified_newton: false,
             rotation_length: None,
+            local_geometric: true,
         }
     }
 }
@@ -647,7 +653,7 @@ pub fn nonlinear_path(
 ) -> Result<Path, FeError> {
     options.validate()?;
     let t_all = Instant::now();
-    let problem = Problem::new(model, options.rotation_length)?;
+    let problem = Problem::new(model, options.rotation_length, options.local_geometric)?;
     let mut solver = Solver {
         p: &problem,
         opt: options,

@@ -16,11 +16,9 @@ fn cylinder(nonlinear: &str) -> Resolved {
 
 #[test]
 fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
-    // 12 layers on the example's own 48 segments (on 24 the co-rotational facets' critical
-    // load is 5 % above the same mesh's LBA, docs/collapse.md §4), the material check off:
-    // the path ends at the limit point only. The perfect path (w0 = 0) bifurcates at the
-    // state's LBA factor; the imperfect ones reach a load maximum below it, rising towards it
-    // as w0 falls.
+    // 12 layers on the example's own 48 segments, the material check off: the path ends at
+    // the limit point only. The imperfect paths' load maxima converge to the perfect path's
+    // critical point as w0 falls.
     let n = 12;
     let mut factors = Vec::new();
     let mut lba = 0.0;
@@ -36,29 +34,77 @@ fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
         assert_eq!(c.lba, lba);
         factors.push(c.factor);
     }
-    // The imperfect paths converge to the perfect path's bifurcation: within 1 % at
-    // w0 = 0.02 mm (w0/t = 5e-4; Koiter's √w0 law leaves ~1 % there on the frames of
-    // docs/nonlinear.md).
+    // Within 1 % at w0 = 0.02 mm (w0/t = 5e-4; Koiter's √w0 law leaves ~1 % there on the
+    // frames of docs/nonlinear.md).
     let last = factors[factors.len() - 1];
     let near = factors[factors.len() - 2];
     assert!(
         (near / last - 1.0).abs() < 0.01,
         "w0 = 0.02 mm: {near} vs w0 = 0: {last}"
     );
-    // That bifurcation is NOT within the 1 % of this mesh's LBA factor: the
-    // co-rotational facets' geometric stiffness (rigid rotation of flat facets) is stiffer
-    // than the linear solver's K_G (DKMT rotations) on this mesh, 8.5 % at 12 layers
-    // (docs/collapse.md §4, a known miss). What holds: it is never below the LBA factor
-    // (both discretise the same critical load from above) and the gap stays under 10 %
-    // (the measured 8.5 % with room for round-off; this bound records the miss, it is not a
-    // justified tolerance).
-    assert!(last >= lba * (1.0 - 1e-3), "w0 = 0: {last} vs LBA {lba}");
-    assert!(last < 1.10 * lba, "w0 = 0: {last} vs LBA {lba}");
-    // At 12 layers (H/t = 3) the state is imperfection-insensitive: even w0 = 2 mm = t/20
-    // moves the limit point by under 0.1 % (measured 0.08 %). 1 % bounds every w0 here.
-    for f in &factors {
-        assert!((f / last - 1.0).abs() < 0.01, "{factors:?}");
+    // The perfect path's critical point lies ABOVE the LBA factor: at buckling this fresh
+    // wall is compressed by up to ~18 % at its base (σ ≈ 15 kPa on E ≈ 83 kPa at λ ≈ 6), and the shortened,
+    // pre-deformed cylinder is stiffer than the undeformed one the LBA linearises about.
+    // That is physics, not the element (docs/collapse.md §4): CalculiX NLGEOM on the identical
+    // model (S6, 24 segments) finds its perfect path's critical point 7.0 % above its own
+    // *BUCKLE factor, Kappe's 5.0 % on that mesh; on 48 segments Kappe's is 11.4 % above
+    // (measured). Checked here: above, and by less than 20 % (a loose bound on the measured
+    // 11.4 %: the size of the pre-buckling effect depends on the strain measure at such
+    // strains, which differs between codes; this bound guards against a lost bifurcation).
+    assert!(last > lba, "w0 = 0: {last} vs LBA {lba}");
+    assert!(last < 1.20 * lba, "w0 = 0: {last} vs LBA {lba}");
+    // The limit load rises monotonically as w0 falls (measured λ_c/λ_c(0) = 0.877, 0.990,
+    // 0.9994 at w0 = 2, 0.2, 0.02 mm; CalculiX on 24 segments: 0.866 at 0.2 mm). Round-off
+    // allowance 0.1 % between neighbours (the path brackets a limit to 10⁻³ in λ).
+    for w in factors.windows(2) {
+        assert!(w[0] <= w[1] * (1.0 + 1e-3), "{factors:?}");
     }
+}
+
+/// The part of λ_c → λ_LBA that is the element's (docs/collapse.md §4): on the identical
+/// 12-layer state, the co-rotational model's own initial-stress stiffness (its tangent's
+/// terms linear in the stresses of the linear solution) gives the LBA's critical factor
+/// within the 1 % once the facets are fine enough for the O(h²) coupling term of the
+/// rigid-facet split (measured on 48 segments: −1.57 %; split 2×2: −0.33 %; 96 segments:
+/// −0.42 %; without the facets' local von Kármán terms +4.9 % on all three).
+#[test]
+fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
+    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, Linearisation, buckling, linearised_critical_factor};
+    let n = 12;
+    let r = BuildabilitySpec::from_toml_str(EXAMPLE_TOML).unwrap();
+    let (mut model, layers) = object_shell(&r, n);
+    let ages = r.schedule.ages(n);
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+    )
+    .unwrap();
+    let model = kappe_fe::refine::split(&model, 2).model;
+    let lba = buckling(
+        &model,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+    .factors[0];
+    let sigma = linearised_critical_factor(
+        &model,
+        lba,
+        1e-4,
+        Linearisation::InitialStress {
+            local_geometric: true,
+        },
+    )
+    .unwrap()
+    .lambda;
+    assert!((sigma / lba - 1.0).abs() < 0.01, "{sigma} vs LBA {lba}");
 }
 
 #[test]
