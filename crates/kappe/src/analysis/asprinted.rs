@@ -116,8 +116,8 @@ pub fn accumulate(increments: &[Increment]) -> AsPrinted {
     for (k, inc) in increments.iter().enumerate() {
         for (key, x, du) in &inc.nodes {
             let e = dev.entry(*key).or_insert((*x, [0.0; 3]));
-            for c in 0..3 {
-                e.1[c] += du[c];
+            for (sum, d) in e.1.iter_mut().zip(du) {
+                *sum += d;
             }
         }
         // Crown of each layer: its highest design node.

@@ -223,3 +223,38 @@ fn the_cap_as_printed_pass_reports_every_state() {
         p4.deviation_m
     );
 }
+
+#[test]
+fn a_deviation_above_deviation_max_fails_the_design_with_its_levers() {
+    // 1 µm is far below the short cap's sag (≈ 1 mm on the default cap): the row must fail,
+    // every state past the first sag fails, and the verdict names the constraint.
+    let design =
+        kappe::Design::from_toml_str("[cap]\nlength = 0.2\n[constraints]\ndeviation_max = 1e-6\n")
+            .expect("design");
+    assert_eq!(design.deviation_max(), 1e-6);
+    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let mut options = design.analysis.clone();
+    options.states = "every:1000".parse().expect("selection");
+    options.converged_blf = false;
+    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    assert!(!a.ok);
+    let row = a
+        .constraints
+        .iter()
+        .find(|c| c.name == "deviation_max")
+        .expect("row");
+    assert!(!row.pass && row.element.starts_with("layer "), "{row:?}");
+    let report = a.report();
+    assert!(report.contains("deviation_max FAIL"), "{report}");
+    assert!(report.contains(kappe::analysis::check::levers("deviation_max")));
+    assert!(a.states.iter().any(|s| !s.ok));
+    let v = kappe::verdict::verdict(&cap, Some(&a), Default::default());
+    assert!(v.failures.iter().any(|f| matches!(
+        f,
+        kappe::verdict::Failure::Constraint { name, .. } if name == "deviation_max"
+    )));
+    // A limit that is not a positive length is rejected, naming the field.
+    let e = kappe::Design::from_toml_str("[constraints]\ndeviation_max = -0.001\n")
+        .expect_err("negative limit");
+    assert!(e.to_string().contains("constraints.deviation_max"), "{e}");
+}
