@@ -120,13 +120,16 @@ pub fn accumulate(increments: &[Increment]) -> AsPrinted {
                 *sum += d;
             }
         }
-        // Crown of each layer: its highest design node.
-        let mut crowns: HashMap<i32, (f64, f64)> = HashMap::new();
+        // Crown of each layer: its highest design node (of two at the same height, the one
+        // earlier in the layer, so the answer does not depend on the hash order).
+        let mut crowns: HashMap<i32, (f64, usize, f64)> = HashMap::new();
         let mut worst: Option<(f64, NodeKey, [f64; 3])> = None;
         for (key, (x, u)) in &dev {
-            let c = crowns.entry(key.0).or_insert((f64::NEG_INFINITY, 0.0));
-            if x[2] > c.0 {
-                *c = (x[2], -u[2]);
+            let c = crowns
+                .entry(key.0)
+                .or_insert((f64::NEG_INFINITY, usize::MAX, 0.0));
+            if x[2] > c.0 || (x[2] == c.0 && key.1 < c.1) {
+                *c = (x[2], key.1, -u[2]);
             }
             let m = norm(*u);
             // Ties broken by key, so the answer does not depend on the hash order.
@@ -139,11 +142,11 @@ pub fn accumulate(increments: &[Increment]) -> AsPrinted {
         }
         let crown = crowns
             .iter()
-            .filter(|(_, c)| c.1 > 0.0)
-            .max_by(|a, b| a.1.1.total_cmp(&b.1.1).then(b.0.cmp(a.0)));
+            .filter(|(_, c)| c.2 > 0.0)
+            .max_by(|a, b| a.1.2.total_cmp(&b.1.2).then(b.0.cmp(a.0)));
         states.push(StateDeviation {
             state: k,
-            crown_sag_m: crown.map_or(0.0, |c| c.1.1),
+            crown_sag_m: crown.map_or(0.0, |c| c.1.2),
             crown_sag_layer: crown.map(|c| *c.0),
             deviation_m: worst.as_ref().map_or(0.0, |w| w.0),
             deviation_layer: worst.as_ref().map(|w| w.1.0),

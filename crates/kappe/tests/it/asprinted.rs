@@ -203,6 +203,10 @@ fn the_cap_as_printed_pass_reports_every_state() {
     assert_eq!(row.worst, Some(top));
     assert_eq!(row.state, p.state);
     assert_eq!(row.limit, design.deviation_max());
+    // Deterministic: a second pass (new hash maps, other thread timing) gives the same bits.
+    let again = kappe::analysis::asprinted::cap_as_printed(&cap, &options, None, &|| Ok(()))
+        .expect("again");
+    assert_eq!(&again, p);
     // A crown never sinks by more than the largest deviation.
     for s in &p.states {
         assert!(s.crown_sag_m <= s.deviation_m + 1e-15, "{s:?}");
