@@ -262,3 +262,33 @@ fn a_deviation_above_deviation_max_fails_the_design_with_its_levers() {
         .expect_err("negative limit");
     assert!(e.to_string().contains("constraints.deviation_max"), "{e}");
 }
+
+#[test]
+fn the_collapse_curve_runs_up_to_the_collapse_factor() {
+    // The report's load–deflection curve (docs/collapse.md): the Wolfs cylinder example at 20
+    // layers on 24 segments (quick), the material check off (the path ends at its limit point).
+    use kappe::commands::buildability::{BuildabilitySpec, EXAMPLE_TOML, check_layers};
+    let text = EXAMPLE_TOML.replace("# segments = 48", "segments = 24");
+    let r = BuildabilitySpec::from_toml_str(&format!(
+        "{text}\n[analysis.nonlinear]\nmaterial = false\n"
+    ))
+    .expect("spec");
+    let c = check_layers(&r, 20)
+        .expect("layers")
+        .collapse
+        .expect("collapse");
+    let curve = &c.curve;
+    assert!(!curve.is_empty() && curve.len() <= kappe::analysis::collapse::CURVE_POINTS);
+    // Every point but the last lies below the collapse factor: the curve stops at the first
+    // step at or past it.
+    for p in &curve[..curve.len() - 1] {
+        assert!(p[0] < c.factor && p[1] >= 0.0, "{p:?} vs {}", c.factor);
+    }
+    // The curve's deflection at the last step with λ ≤ 1 is the path's own sag at λ ≤ 1
+    // (`deflection_at_1`, computed separately along the path), when the curve is not thinned.
+    if c.steps <= kappe::analysis::collapse::CURVE_POINTS {
+        if let Some(p) = curve.iter().rev().find(|p| p[0] <= 1.0) {
+            assert_eq!(p[1], c.deflection_at_1);
+        }
+    }
+}
