@@ -286,9 +286,9 @@ fn the_collapse_curve_runs_up_to_the_collapse_factor() {
     }
     // The curve's deflection at the last step with λ ≤ 1 is the path's own sag at λ ≤ 1
     // (`deflection_at_1`, computed separately along the path), when the curve is not thinned.
-    if c.steps <= kappe::analysis::collapse::CURVE_POINTS {
-        if let Some(p) = curve.iter().rev().find(|p| p[0] <= 1.0) {
-            assert_eq!(p[1], c.deflection_at_1);
-        }
+    if c.steps <= kappe::analysis::collapse::CURVE_POINTS
+        && let Some(p) = curve.iter().rev().find(|p| p[0] <= 1.0)
+    {
+        assert_eq!(p[1], c.deflection_at_1);
     }
 }
