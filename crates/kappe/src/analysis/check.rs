@@ -89,6 +89,10 @@ pub struct StateAnalysis {
     /// What ends its path there: `limit_point` or the material check that failed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collapse_mode: Option<crate::analysis::collapse::CollapseMode>,
+    /// The collapse path's load–deflection curve ([`crate::analysis::collapse::Collapse::curve`];
+    /// empty when the state's collapse was not run). Not in `summary.json`.
+    #[serde(skip)]
+    pub collapse_curve: Vec<[f64; 2]>,
     /// Mode 1 per shell node (network node index, translation), for the report's 3D view;
     /// empty when not analysed. Not in `summary.json`.
     #[serde(skip)]
@@ -132,6 +136,9 @@ pub struct Timings {
     pub fe_sum: f64,
     /// Whole analysis.
     pub total: f64,
+    /// The as-printed pass (docs/as-printed.md), wall clock.
+    #[serde(default)]
+    pub as_printed: f64,
 }
 
 /// The analysis of a cap: per state, the constraint report and the verdict.
@@ -147,6 +154,8 @@ pub struct Analysis {
     pub options: AnalysisOptions,
     /// Timings.
     pub timings: Timings,
+    /// The as-printed shape (docs/as-printed.md; None when the buckling analysis is off).
+    pub as_printed: Option<crate::analysis::asprinted::AsPrinted>,
 }
 
 impl Analysis {
@@ -220,6 +229,11 @@ pub fn levers(name: &str) -> &'static str {
              waits)"
         }
         "overhang_max" => "the layers overhang too far: lower cap.tilt_deg or print.layer_height",
+        "deviation_max" => {
+            "the print sags out of its design shape as it is built (docs/as-printed.md): raise \
+             cap.rise, widen the layers (print.layer_width), or wait between layers so the lower \
+             layers stiffen before they carry the next (`kappe schedule`)"
+        }
         "collapse_min" => {
             "the imperfect state collapses (docs/collapse.md): raise cap.rise, widen the layers \
              (print.layer_width), wait between layers so they stiffen and strengthen (`kappe \
@@ -904,6 +918,7 @@ fn assemble(
             fe_seconds: p.fe_seconds,
             collapse_factor: None,
             collapse_mode: None,
+            collapse_curve: Vec::new(),
             mode: p.mode.clone(),
         });
     }
@@ -951,6 +966,7 @@ fn assemble(
                 collapse_checked += 1;
                 s.collapse_factor = Some(c.factor);
                 s.collapse_mode = Some(c.mode);
+                s.collapse_curve = c.curve.clone();
                 s.ok &= c.factor >= collapse_min;
                 keep_min(&mut w_collapse, c.factor, q, || {
                     format!(
@@ -964,6 +980,21 @@ fn assemble(
         }
     }
     let wall_collapse = t_collapse.elapsed().as_secs_f64();
+
+    // The as-printed shape (docs/as-printed.md): every state's increment under its new weight.
+    let t_printed = Instant::now();
+    let deviation_max = design.deviation_max();
+    let as_printed = if options.buckling && total > 0 {
+        let a =
+            crate::analysis::asprinted::cap_as_printed(cap, options, green.as_ref(), &cancelled)?;
+        for (s, d) in states.iter_mut().zip(&a.states) {
+            s.ok &= d.deviation_m <= deviation_max;
+        }
+        Some(a)
+    } else {
+        None
+    };
+    let wall_printed = t_printed.elapsed().as_secs_f64();
 
     let result = |name: &'static str,
                   description: &'static str,
@@ -1034,6 +1065,27 @@ fn assemble(
             &|v| v >= collapse_min,
         ));
     }
+    if let Some(a) = &as_printed {
+        let w = a.state.map(|state| Worst {
+            value: a.deviation_m,
+            state,
+            element: match (a.layer, a.at_m) {
+                (Some(l), Some(x)) => {
+                    format!("layer {l} at ({:.3}, {:.3}, {:.3}) m", x[0], x[1], x[2])
+                }
+                _ => String::new(),
+            },
+        });
+        constraints.push(result(
+            "deviation_max",
+            "as-printed shape: deviation from the design ≤ deviation_max at every node in every state",
+            "m",
+            deviation_max,
+            w,
+            a.states.len(),
+            &|v| v <= deviation_max,
+        ));
+    }
     if green.as_ref().is_some_and(|g| g.time.strength.is_some()) {
         constraints.push(result(
             "strength",
@@ -1066,6 +1118,8 @@ fn assemble(
             fe: wall_fe + wall_collapse,
             fe_sum: t_fe,
             total: t_all.elapsed().as_secs_f64(),
+            as_printed: wall_printed,
         },
+        as_printed,
     })
 }

@@ -96,8 +96,30 @@ pub struct Collapse {
     pub deflection_at_1: f64,
     /// Converged steps of the governing path.
     pub steps: usize,
+    /// The governing path's load–deflection curve up to the collapse factor: (λ, largest
+    /// translation relative to the imperfect geometry, m) per converged step, at most
+    /// [`CURVE_POINTS`] points (the report's plot; not in `summary.json`).
+    pub curve: Vec<[f64; 2]>,
     /// Tangent assemblies over all paths run.
     pub assemblies: usize,
+}
+
+/// Most points of [`Collapse::curve`]: enough to draw a smooth curve, few enough for the
+/// report input.
+pub const CURVE_POINTS: usize = 64;
+
+/// Every k-th point of `v` so at most `n` remain, always keeping the last.
+fn thin(v: Vec<[f64; 2]>, n: usize) -> Vec<[f64; 2]> {
+    if v.len() <= n || n < 2 {
+        return v;
+    }
+    let step = v.len().div_ceil(n - 1);
+    let last = v[v.len() - 1];
+    let mut out: Vec<[f64; 2]> = v.into_iter().step_by(step).collect();
+    if out.last() != Some(&last) {
+        out.push(last);
+    }
+    out
 }
 
 /// The collapse factor of a state (module docs). `model` carries the aged moduli, supports and
@@ -123,6 +145,7 @@ pub fn collapse_factor(
             sign: 1.0,
             deflection_at_1: 0.0,
             steps: 0,
+            curve: Vec::new(),
             assemblies: 0,
         });
     }
@@ -263,6 +286,20 @@ fn one_path(
             _ => (last_lambda, CollapseMode::NoConvergence),
         },
     };
+    // The curve ends at the first step at or past the collapse factor (a path that turns back
+    // at a limit point is drawn up to the step after it).
+    let mut curve: Vec<[f64; 2]> = Vec::new();
+    for st in &path.steps {
+        let u = st
+            .displacements
+            .iter()
+            .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+            .fold(0.0, f64::max);
+        curve.push([st.lambda, u]);
+        if st.lambda >= factor || st.limit_passed {
+            break;
+        }
+    }
     Ok(Collapse {
         factor,
         mode: cmode,
@@ -271,6 +308,7 @@ fn one_path(
         sign,
         deflection_at_1,
         steps: path.steps.len(),
+        curve: thin(curve, CURVE_POINTS),
         assemblies: path.stats.assemblies,
     })
 }
@@ -377,6 +415,7 @@ pub fn cap_state_collapse(
                 sign: 1.0,
                 deflection_at_1: 0.0,
                 steps: 0,
+                curve: Vec::new(),
                 assemblies: 0,
             }));
         }

@@ -169,6 +169,10 @@ pub struct ConstraintSpec {
     /// docs/collapse.md). Default 1.0: the state collapses under its own weight.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collapse_min: Option<f64>,
+    /// Largest allowed deviation of the as-printed shape from the design, m (issue 23,
+    /// docs/as-printed.md). Default half the layer height ([`Design::deviation_max`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deviation_max: Option<f64>,
 }
 
 impl ConstraintSpec {
@@ -491,6 +495,7 @@ impl Default for ConstraintSpec {
             overhang_max: None,
             beta_min: None,
             collapse_min: None,
+            deviation_max: None,
         }
     }
 }
@@ -565,6 +570,15 @@ impl Design {
         self.constraints
             .overhang_max
             .unwrap_or(0.5 * self.print.layer_width)
+    }
+
+    /// The largest allowed as-printed deviation, m: `constraints.deviation_max`, defaulting to
+    /// half the layer height (docs/as-printed.md §4: a bead laid at its programmed height over
+    /// a layer sunk by more than lh/2 bonds to it over less than half its designed contact).
+    pub fn deviation_max(&self) -> f64 {
+        self.constraints
+            .deviation_max
+            .unwrap_or(0.5 * self.print.layer_height)
     }
 
     /// Check every field against its allowed range (method.md §2–3).
@@ -726,6 +740,14 @@ impl Design {
                 c,
                 c.is_finite() && c > 0.0,
                 "allowed: collapse_min > 0 (1: collapse under the state's own weight)",
+            )?;
+        }
+        if let Some(d) = k.deviation_max {
+            check(
+                "constraints.deviation_max",
+                d,
+                d.is_finite() && d > 0.0,
+                "allowed: deviation_max > 0 m",
             )?;
         }
         if let Some(lo) = k.overhang_max {

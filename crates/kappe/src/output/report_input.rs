@@ -112,12 +112,95 @@ pub fn extras_from_analysis(analysis: &crate::analysis::Analysis) -> ReportExtra
         .filter_map(|(i, s)| Some((i, s.blf?, s.mode.clone())))
         .filter(|(_, _, m)| !m.is_empty())
         .collect();
+    let plots = analysis
+        .as_printed
+        .as_ref()
+        .map(|a| {
+            let limit = analysis
+                .constraints
+                .iter()
+                .find(|c| c.name == "deviation_max")
+                .map(|c| c.limit);
+            as_printed_plot(a, limit)
+        })
+        .into_iter()
+        .chain(collapse_plot(analysis))
+        .collect();
     ReportExtras {
         states,
         constraints,
         modes,
+        plots,
         ..ReportExtras::default()
     }
+}
+
+/// The as-printed deviation over the print (docs/as-printed.md): crown sag and the largest
+/// deviation after every state, with the limit `deviation_max`, in mm.
+fn as_printed_plot(a: &crate::analysis::asprinted::AsPrinted, limit: Option<f64>) -> Plot {
+    let mm = |f: &dyn Fn(&crate::analysis::asprinted::StateDeviation) -> f64| -> Vec<[f64; 2]> {
+        a.states
+            .iter()
+            .map(|s| [s.state as f64, 1e3 * f(s)])
+            .collect()
+    };
+    let mut series = vec![
+        Series {
+            name: "largest deviation".into(),
+            points: mm(&|s| s.deviation_m),
+        },
+        Series {
+            name: "crown sag".into(),
+            points: mm(&|s| s.crown_sag_m),
+        },
+    ];
+    if let (Some(l), Some(first), Some(last)) = (limit, a.states.first(), a.states.last()) {
+        series.push(Series {
+            name: format!("deviation_max = {:.1} mm", 1e3 * l),
+            points: vec![[first.state as f64, 1e3 * l], [last.state as f64, 1e3 * l]],
+        });
+    }
+    Plot {
+        title: format!(
+            "As-printed deviation from the design per state (largest {:.2} mm{})",
+            1e3 * a.deviation_m,
+            a.state.map_or(String::new(), |s| format!(" at state {s}"))
+        ),
+        x_label: "print state".into(),
+        y_label: "deviation [mm]".into(),
+        series,
+    }
+}
+
+/// The governing collapse state's load–deflection curve (`[analysis.nonlinear]`): load factor
+/// against the largest displacement along the path.
+fn collapse_plot(analysis: &crate::analysis::Analysis) -> Option<Plot> {
+    let s = analysis
+        .states
+        .iter()
+        .filter(|s| !s.collapse_curve.is_empty())
+        .min_by(|a, b| {
+            let f = |s: &crate::analysis::StateAnalysis| s.collapse_factor.unwrap_or(f64::INFINITY);
+            f(a).total_cmp(&f(b))
+        })?;
+    Some(Plot {
+        title: format!(
+            "Collapse path of the governing state {} (collapse factor {:.3}, {})",
+            s.index,
+            s.collapse_factor.unwrap_or(f64::NAN),
+            s.collapse_mode.map_or("", |m| m.name())
+        ),
+        x_label: "largest displacement [mm]".into(),
+        y_label: "load factor λ [-]".into(),
+        series: vec![Series {
+            name: format!("state {}", s.index),
+            points: s
+                .collapse_curve
+                .iter()
+                .map(|p| [1e3 * p[1], p[0]])
+                .collect(),
+        }],
+    })
 }
 
 /// A constraint in the report's units (stresses in kPa, overhang in mm; the analysis gives Pa
@@ -131,7 +214,7 @@ fn row_of(c: &crate::analysis::ConstraintResult) -> Option<ConstraintRow> {
         other => (1.0, other),
     };
     let bound = match c.name {
-        "sigma_max" | "overhang_max" => Bound::AtMost,
+        "sigma_max" | "overhang_max" | "deviation_max" => Bound::AtMost,
         _ => Bound::AtLeast,
     };
     Some(ConstraintRow {

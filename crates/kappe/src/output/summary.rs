@@ -75,6 +75,9 @@ pub struct Summary {
     pub ok: bool,
     /// The failing checks (empty when `ok`).
     pub failures: Vec<Failure>,
+    /// The as-printed shape over the print (docs/as-printed.md; absent without an analysis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub as_printed: Option<AsPrintedSummary>,
     /// The print's reliability under `[uncertainty]` (issue 24; absent without it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reliability: Option<crate::analysis::reliability::Reliability>,
@@ -209,6 +212,16 @@ pub struct StateEntry {
     /// `not_reached`, `no_convergence`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collapse_mode: Option<String>,
+    /// As-printed crown sag after this state, m (docs/as-printed.md: the largest downward
+    /// deviation at the crown of any printed layer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crown_sag_m: Option<f64>,
+    /// The largest as-printed deviation of any printed node after this state, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deviation_m: Option<f64>,
+    /// Layer of that node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deviation_layer: Option<i32>,
     /// Every checked constraint holds in this state (absent without an analysis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ok: Option<bool>,
@@ -224,6 +237,28 @@ pub struct StateEntry {
     /// β per check, e.g. `{"buckling": …, "sigma_min": …}` (only with `[uncertainty]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta_by_check: Option<std::collections::BTreeMap<String, f64>>,
+}
+
+/// The as-printed shape over the whole print (per state: `states[].crown_sag_m`,
+/// `states[].deviation_m`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct AsPrintedSummary {
+    /// The largest deviation of any node from its design position over the print, m.
+    pub deviation_m: f64,
+    /// State where it occurs.
+    pub state: Option<usize>,
+    /// Layer of that node.
+    pub layer: Option<i32>,
+    /// Design position of that node, m.
+    pub at_m: Option<[f64; 3]>,
+    /// The largest crown sag over the print, m.
+    pub crown_sag_m: f64,
+    /// State of the largest crown sag.
+    pub crown_sag_state: Option<usize>,
+    /// The limit `constraints.deviation_max`, m.
+    pub deviation_max_m: f64,
+    /// The largest relative equilibrium residual of any state's increment.
+    pub max_residual: f64,
 }
 
 /// One constraint of the analysis.
@@ -437,6 +472,8 @@ impl Outcome {
         let nc = cap.arch.segments() / 2;
         let crown = cap.arch.segment_forces.get(nc).copied().unwrap_or(0.0);
         let analysis = self.analysis.as_ref();
+        let printed = analysis.and_then(|a| a.as_printed.as_ref());
+        let dev = |i: usize| printed.and_then(|p| p.states.get(i));
         let states = cap
             .states
             .iter()
@@ -479,6 +516,9 @@ impl Outcome {
                     collapse_mode: a
                         .and_then(|a| a.collapse_mode)
                         .map(|m| m.name().to_string()),
+                    crown_sag_m: dev(i).map(|d| d.crown_sag_m),
+                    deviation_m: dev(i).map(|d| d.deviation_m),
+                    deviation_layer: dev(i).and_then(|d| d.deviation_layer),
                     ok: a.map(|a| a.ok),
                     mechanism: a.and_then(|a| a.mechanism.clone()),
                     beta: r.map(|r| r.beta),
@@ -558,6 +598,16 @@ impl Outcome {
             ok: self.verdict.ok,
             failures: self.verdict.failures.clone(),
             reliability: self.reliability.clone(),
+            as_printed: printed.map(|p| AsPrintedSummary {
+                deviation_m: p.deviation_m,
+                state: p.state,
+                layer: p.layer,
+                at_m: p.at_m,
+                crown_sag_m: p.crown_sag_m,
+                crown_sag_state: p.crown_sag_state,
+                deviation_max_m: d.deviation_max(),
+                max_residual: p.max_residual,
+            }),
         }
     }
 

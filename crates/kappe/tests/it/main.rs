@@ -3,6 +3,7 @@
 mod analysis;
 mod analysis_loop;
 mod analysis_props;
+mod asprinted;
 mod blf_convergence;
 mod cap;
 mod ceiling;
