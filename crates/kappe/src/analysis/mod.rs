@@ -28,6 +28,7 @@
 //! green material's modulus by layer age), [`buckling`] (the shell buckling run of one state)
 //! and [`check`] ([`analyze`]: every state against every constraint, and the report).
 
+pub mod blf_sensitivity;
 pub mod buckling;
 pub mod check;
 pub mod collapse;

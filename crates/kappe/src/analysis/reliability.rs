@@ -116,12 +116,22 @@ pub enum Check {
     Tension(f64),
     /// u₀.
     Strength(f64),
+    /// Buckling with the time model's E₀ and/or Ė uncertain: BLF₀, s_ν and the state's top
+    /// print index; g from re-solves of the state's shell ([`TimeBuckling`]).
+    BucklingTime {
+        /// BLF at the design's values.
+        blf: f64,
+        /// (∂BLF/∂ν)/BLF₀.
+        s_nu: f64,
+        /// Top print index of the state.
+        top: usize,
+    },
 }
 
 impl Check {
     fn name(self) -> &'static str {
         match self {
-            Check::Buckling { .. } => "buckling",
+            Check::Buckling { .. } | Check::BucklingTime { .. } => "buckling",
             Check::Compression(_) => "sigma_min",
             Check::Tension(_) => "sigma_max",
             Check::Strength(_) => "strength",
@@ -138,6 +148,16 @@ pub struct Vars {
     gamma0: f64,
     e0: f64,
     nu0: f64,
+    /// The time model's E₀ and Ė (`material.time.*`).
+    e0t: Option<usize>,
+    rate: Option<usize>,
+}
+
+impl Vars {
+    /// Whether a time-model parameter is uncertain.
+    pub fn has_time(&self) -> bool {
+        self.e0t.is_some() || self.rate.is_some()
+    }
 }
 
 impl Vars {
@@ -152,6 +172,8 @@ impl Vars {
             gamma0: m.specific_weight,
             e0: m.youngs_modulus,
             nu0: m.poisson_ratio,
+            e0t: find("material.time.youngs_modulus"),
+            rate: find("material.time.youngs_modulus_rate"),
         }
     }
 }
@@ -197,6 +219,115 @@ pub fn limit_state(
             set(v.gamma, -u / v.gamma0);
             1.0 - u * rg
         }
+        // Needs re-solves: [`TimeBuckling`]. Here the nominal-stiffness value, which keeps this
+        // pure function total.
+        Check::BucklingTime { blf, s_nu, .. } => {
+            let nu = at(v.nu, v.nu0);
+            let lin = 1.0 + s_nu * (nu - v.nu0);
+            let val = blf / rg * lin;
+            set(v.gamma, -val / gamma);
+            set(v.nu, blf / rg * s_nu);
+            val - blf_min
+        }
+    }
+}
+
+/// The buckling limit state of one state when the time model's E₀ and/or Ė are uncertain:
+/// g = BLF₀·(λ(E₀, Ė)/λ(E₀⁰, Ė⁰))·(γ₀/γ)·(1 + s_ν(ν − ν₀)) − BLF_min, with λ the lowest factor of
+/// a re-solve of the state's shell at the trial E₀, Ė (their moduli change non-uniformly with
+/// the layers' ages, so no scaling is exact) and ∂λ/∂E₀, ∂λ/∂Ė from the eigenvalue sensitivity
+/// ([`crate::analysis::blf_sensitivity`]). The ratio keeps g equal to the deterministic verdict's
+/// BLF₀ at the nominal values even when that BLF is the mesh-converged estimate.
+pub struct TimeBuckling<'a> {
+    /// The cap.
+    pub cap: &'a Cap,
+    /// The analysis options (the shell the analysis builds).
+    pub options: &'a super::AnalysisOptions,
+    /// The run's schedule (the layers' ages).
+    pub schedule: &'a crate::schedule::Schedule,
+    /// The design's time model (E₀, Ė replaced per trial point).
+    pub time: crate::input::material::TimeModel,
+    /// Where the variables sit.
+    pub vars: Vars,
+    /// BLF₀, s_ν and the top print index.
+    pub check: (f64, f64, usize),
+    /// BLF_min.
+    pub blf_min: f64,
+    /// λ of the shell at the nominal E₀, Ė (computed on first use).
+    pub shell0: Option<f64>,
+}
+
+/// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
+/// square (symmetric pencil), far below FORM's tolerance on g (1e-6 relative).
+pub const RESOLVE_TOLERANCE: f64 = 1e-8;
+
+impl TimeBuckling<'_> {
+    fn solve(&self, e0: f64, rate: f64) -> Result<(f64, [f64; 2]), kappe_reliability::EvalError> {
+        let mut time = self.time.clone();
+        time.youngs_modulus.initial = e0;
+        time.youngs_modulus.rate = rate;
+        let top = self.check.2;
+        crate::analysis::blf_sensitivity::time_state_blf(
+            self.cap,
+            self.options,
+            self.schedule,
+            &time,
+            top,
+            RESOLVE_TOLERANCE,
+        )?
+        .ok_or_else(|| {
+            format!("state {top}: no positive buckling factor at E₀ = {e0} Pa, Ė = {rate} Pa/s")
+                .into()
+        })
+    }
+
+    fn eval(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, kappe_reliability::EvalError> {
+        let v = self.vars;
+        let p = self.time.youngs_modulus;
+        let at =
+            |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+        let shell0 = match self.shell0 {
+            Some(l) => l,
+            None => {
+                let l = self.solve(p.initial, p.rate)?.0;
+                self.shell0 = Some(l);
+                l
+            }
+        };
+        let (blf, s_nu, _) = self.check;
+        let (l, dl) = self.solve(at(v.e0t, p.initial), at(v.rate, p.rate))?;
+        let gamma = at(v.gamma, v.gamma0);
+        let rg = gamma / v.gamma0;
+        let nu = at(v.nu, v.nu0);
+        let lin = 1.0 + s_nu * (nu - v.nu0);
+        let k = blf / shell0;
+        let val = k * l / rg * lin;
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        let mut set = |i: Option<usize>, d: f64| {
+            if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+                *g = d;
+            }
+        };
+        set(v.e0t, k * dl[0] / rg * lin);
+        set(v.rate, k * dl[1] / rg * lin);
+        set(v.gamma, -val / gamma);
+        set(v.nu, k * l / rg * s_nu);
+        Ok(val - self.blf_min)
+    }
+}
+
+impl kappe_reliability::LimitState for TimeBuckling<'_> {
+    fn value(&mut self, x: &[f64]) -> Result<f64, kappe_reliability::EvalError> {
+        let mut g = vec![0.0; x.len()];
+        self.eval(x, &mut g)
+    }
+
+    fn value_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<Option<f64>, kappe_reliability::EvalError> {
+        self.eval(x, grad).map(Some)
     }
 }
 
@@ -222,7 +353,7 @@ fn state_checks(
         let t_hours = schedule.layers.get(s.index).map_or(0.0, |l| l.end_s) / 3600.0;
         let mut checks = Vec::new();
         if let Some(blf) = s.blf
-            && (v.gamma.is_some() || v.e.is_some() || v.nu.is_some())
+            && (v.gamma.is_some() || v.e.is_some() || v.nu.is_some() || v.has_time())
         {
             let s_nu = if v.nu.is_some() {
                 // ∂BLF/∂ν by a central difference of two re-solves (see the module docs).
@@ -238,7 +369,15 @@ fn state_checks(
             } else {
                 0.0
             };
-            checks.push(Check::Buckling { blf, s_nu });
+            checks.push(if v.has_time() {
+                Check::BucklingTime {
+                    blf,
+                    s_nu,
+                    top: s.index,
+                }
+            } else {
+                Check::Buckling { blf, s_nu }
+            });
         }
         if v.gamma.is_some() {
             // A stress check is random only when its sign can change with γ > 0: σ_min < 0 and a
@@ -314,7 +453,23 @@ pub fn reliability(
         let mut by_check = BTreeMap::new();
         let mut own = Vec::new();
         for check in checks {
-            let r = check_form(&state_model, check, v, limits).map_err(rel_err)?;
+            let r = match check {
+                Check::BucklingTime { blf, s_nu, top } => {
+                    let mut g = TimeBuckling {
+                        cap,
+                        options: &analysis.options,
+                        schedule,
+                        time: cap.design.time_model()?,
+                        vars: v,
+                        check: (blf, s_nu, top),
+                        blf_min: k.blf_min,
+                        shell0: None,
+                    };
+                    form(&state_model, &mut g, &FormOptions::default())
+                }
+                _ => check_form(&state_model, check, v, limits),
+            }
+            .map_err(rel_err)?;
             by_check.insert(check.name().to_owned(), r.beta);
             own.push(Component::from(&r));
             results.push((index, check.name(), r));
