@@ -577,19 +577,25 @@ pub fn reliability(
     let mut components: Vec<Component> = Vec::new();
     let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
     let mut states = Vec::new();
-    for (index, t_hours, checks) in per_state {
-        let Some((state, rs)) = state_form(
-            cap,
-            &analysis.options,
-            schedule,
-            (&model, &drifts, v),
-            index,
-            t_hours,
-            &checks,
-        )?
-        else {
-            continue;
-        };
+    // States are independent (each its own FORM, its own re-solves): in parallel, collected in
+    // state order, so the result is the sequential one bit for bit.
+    use rayon::prelude::*;
+    let per_state: Vec<_> = per_state
+        .par_iter()
+        .map(|(index, t_hours, checks)| {
+            state_form(
+                cap,
+                &analysis.options,
+                schedule,
+                (&model, &drifts, v),
+                *index,
+                *t_hours,
+                checks,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    for (state, rs) in per_state.into_iter().flatten() {
+        let index = state.index;
         for (name, r) in rs {
             components.push(Component::from(&r));
             results.push((index, name, r));
