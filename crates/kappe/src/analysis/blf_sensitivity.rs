@@ -255,7 +255,8 @@ pub fn time_state_blf(
     let (Some(&blf), Some(mode)) = (r.factors.first(), r.modes.first()) else {
         return Ok(None);
     };
-    let mut de = vec![Vec::with_capacity(shell.element_layers.len()); 2];
+    let ne = shell.element_layers.len();
+    let mut de = vec![Vec::with_capacity(ne), Vec::with_capacity(ne)];
     for (a, b) in &shell.element_layers {
         // The element takes the mean of its two layers' moduli (`state_shell`).
         let da = modulus_derivatives(time, age_of.get(a).copied().unwrap_or(0.0));

@@ -443,12 +443,18 @@ pub fn checks_of(
     Ok(checks)
 }
 
+/// A design's uncertain model, its drifts and where the variables sit.
+pub type Prepared = (Model, Vec<(String, Drift)>, Vars);
+
+/// FORM results of one state: its reliability and each check's FORM result by check name.
+pub type StateForm = (StateReliability, Vec<(&'static str, FormResult)>);
+
 /// The uncertain model of a design, its drifts and where the variables sit: what every state's
 /// FORM needs. None without `[uncertainty]`.
 ///
 /// # Errors
 /// An invalid `[uncertainty]`.
-pub fn prepare(cap: &Cap) -> Result<Option<(Model, Vec<(String, Drift)>, Vars)>, DesignError> {
+pub fn prepare(cap: &Cap) -> Result<Option<Prepared>, DesignError> {
     let Some(table) = &cap.design.uncertainty else {
         return Ok(None);
     };
@@ -473,7 +479,7 @@ pub fn state_form(
     index: usize,
     t_hours: f64,
     checks: &[Check],
-) -> Result<Option<(StateReliability, Vec<(&'static str, FormResult)>)>, DesignError> {
+) -> Result<Option<StateForm>, DesignError> {
     if checks.is_empty() {
         return Ok(None);
     }
