@@ -102,12 +102,28 @@ fn text_report(
         let _ = writeln!(t, "waits needed ({}):", plan.binding.len());
     }
     for b in &plan.binding {
+        let beta = b
+            .beta_before
+            .map_or(String::new(), |v| format!("; β {v:.2} without it"));
         let _ = writeln!(
             t,
-            "  state {:>4}: wait {:.1} s before its top layer ({} binds)",
+            "  state {:>4}: wait {:.1} s before its top layer ({} binds{beta})",
             b.state,
             b.wait_s,
             b.check.map_or("-", |m| m.name())
+        );
+    }
+    if let Some(bm) = plan.beta_min {
+        // [uncertainty]: the target is β ≥ beta_min in every state, drift included (issue 24).
+        let low = plan
+            .states
+            .iter()
+            .filter_map(|c| c.beta)
+            .fold(f64::INFINITY, f64::min);
+        let _ = writeln!(
+            t,
+            "reliability target β ≥ {bm:.2} (constraints.beta_min): lowest state β {low:.2} \
+             with these waits, drift included"
         );
     }
     if plan.infeasible.is_empty() {
@@ -152,6 +168,9 @@ fn text_report(
         }
         if let Some(u) = c.sliding {
             parts.push(format!("sliding used {:.0} %", 100.0 * u));
+        }
+        if let (Some(b), Some(bm)) = (c.beta, plan.beta_min) {
+            parts.push(format!("β {b:.2} (needs {bm:.2})"));
         }
         parts.join(", ")
     };

@@ -17,3 +17,4 @@ mod robot;
 mod schedule;
 mod slurm;
 mod study;
+mod uncertainty;

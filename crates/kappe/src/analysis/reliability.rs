@@ -28,7 +28,8 @@
 use std::collections::BTreeMap;
 
 use kappe_reliability::{
-    Component, FormOptions, FormResult, Model, SystemOptions, WithGradient, form, series_system,
+    Component, Drift, FormOptions, FormResult, Model, SystemOptions, WithGradient, form,
+    series_system,
 };
 use serde::{Deserialize, Serialize};
 
@@ -116,12 +117,22 @@ pub enum Check {
     Tension(f64),
     /// u₀.
     Strength(f64),
+    /// Buckling with the time model's E₀ and/or Ė uncertain: BLF₀, s_ν and the state's top
+    /// print index; g from re-solves of the state's shell ([`TimeBuckling`]).
+    BucklingTime {
+        /// BLF at the design's values.
+        blf: f64,
+        /// (∂BLF/∂ν)/BLF₀.
+        s_nu: f64,
+        /// Top print index of the state.
+        top: usize,
+    },
 }
 
 impl Check {
     fn name(self) -> &'static str {
         match self {
-            Check::Buckling { .. } => "buckling",
+            Check::Buckling { .. } | Check::BucklingTime { .. } => "buckling",
             Check::Compression(_) => "sigma_min",
             Check::Tension(_) => "sigma_max",
             Check::Strength(_) => "strength",
@@ -138,6 +149,16 @@ pub struct Vars {
     gamma0: f64,
     e0: f64,
     nu0: f64,
+    /// The time model's E₀ and Ė (`material.time.*`).
+    e0t: Option<usize>,
+    rate: Option<usize>,
+}
+
+impl Vars {
+    /// Whether a time-model parameter is uncertain.
+    pub fn has_time(&self) -> bool {
+        self.e0t.is_some() || self.rate.is_some()
+    }
 }
 
 impl Vars {
@@ -152,6 +173,8 @@ impl Vars {
             gamma0: m.specific_weight,
             e0: m.youngs_modulus,
             nu0: m.poisson_ratio,
+            e0t: find("material.time.youngs_modulus"),
+            rate: find("material.time.youngs_modulus_rate"),
         }
     }
 }
@@ -197,6 +220,115 @@ pub fn limit_state(
             set(v.gamma, -u / v.gamma0);
             1.0 - u * rg
         }
+        // Needs re-solves: [`TimeBuckling`]. Here the nominal-stiffness value, which keeps this
+        // pure function total.
+        Check::BucklingTime { blf, s_nu, .. } => {
+            let nu = at(v.nu, v.nu0);
+            let lin = 1.0 + s_nu * (nu - v.nu0);
+            let val = blf / rg * lin;
+            set(v.gamma, -val / gamma);
+            set(v.nu, blf / rg * s_nu);
+            val - blf_min
+        }
+    }
+}
+
+/// The buckling limit state of one state when the time model's E₀ and/or Ė are uncertain:
+/// g = BLF₀·(λ(E₀, Ė)/λ(E₀⁰, Ė⁰))·(γ₀/γ)·(1 + s_ν(ν − ν₀)) − BLF_min, with λ the lowest factor of
+/// a re-solve of the state's shell at the trial E₀, Ė (their moduli change non-uniformly with
+/// the layers' ages, so no scaling is exact) and ∂λ/∂E₀, ∂λ/∂Ė from the eigenvalue sensitivity
+/// ([`crate::analysis::blf_sensitivity`]). The ratio keeps g equal to the deterministic verdict's
+/// BLF₀ at the nominal values even when that BLF is the mesh-converged estimate.
+pub struct TimeBuckling<'a> {
+    /// The cap.
+    pub cap: &'a Cap,
+    /// The analysis options (the shell the analysis builds).
+    pub options: &'a super::AnalysisOptions,
+    /// The run's schedule (the layers' ages).
+    pub schedule: &'a crate::schedule::Schedule,
+    /// The design's time model (E₀, Ė replaced per trial point).
+    pub time: crate::input::material::TimeModel,
+    /// Where the variables sit.
+    pub vars: Vars,
+    /// BLF₀, s_ν and the top print index.
+    pub check: (f64, f64, usize),
+    /// BLF_min.
+    pub blf_min: f64,
+    /// λ of the shell at the nominal E₀, Ė (computed on first use).
+    pub shell0: Option<f64>,
+}
+
+/// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
+/// square (symmetric pencil), far below FORM's tolerance on g (1e-6 relative).
+pub const RESOLVE_TOLERANCE: f64 = 1e-8;
+
+impl TimeBuckling<'_> {
+    fn solve(&self, e0: f64, rate: f64) -> Result<(f64, [f64; 2]), kappe_reliability::EvalError> {
+        let mut time = self.time.clone();
+        time.youngs_modulus.initial = e0;
+        time.youngs_modulus.rate = rate;
+        let top = self.check.2;
+        crate::analysis::blf_sensitivity::time_state_blf(
+            self.cap,
+            self.options,
+            self.schedule,
+            &time,
+            top,
+            RESOLVE_TOLERANCE,
+        )?
+        .ok_or_else(|| {
+            format!("state {top}: no positive buckling factor at E₀ = {e0} Pa, Ė = {rate} Pa/s")
+                .into()
+        })
+    }
+
+    fn eval(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, kappe_reliability::EvalError> {
+        let v = self.vars;
+        let p = self.time.youngs_modulus;
+        let at =
+            |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+        let shell0 = match self.shell0 {
+            Some(l) => l,
+            None => {
+                let l = self.solve(p.initial, p.rate)?.0;
+                self.shell0 = Some(l);
+                l
+            }
+        };
+        let (blf, s_nu, _) = self.check;
+        let (l, dl) = self.solve(at(v.e0t, p.initial), at(v.rate, p.rate))?;
+        let gamma = at(v.gamma, v.gamma0);
+        let rg = gamma / v.gamma0;
+        let nu = at(v.nu, v.nu0);
+        let lin = 1.0 + s_nu * (nu - v.nu0);
+        let k = blf / shell0;
+        let val = k * l / rg * lin;
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        let mut set = |i: Option<usize>, d: f64| {
+            if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+                *g = d;
+            }
+        };
+        set(v.e0t, k * dl[0] / rg * lin);
+        set(v.rate, k * dl[1] / rg * lin);
+        set(v.gamma, -val / gamma);
+        set(v.nu, k * l / rg * s_nu);
+        Ok(val - self.blf_min)
+    }
+}
+
+impl kappe_reliability::LimitState for TimeBuckling<'_> {
+    fn value(&mut self, x: &[f64]) -> Result<f64, kappe_reliability::EvalError> {
+        let mut g = vec![0.0; x.len()];
+        self.eval(x, &mut g)
+    }
+
+    fn value_and_gradient(
+        &mut self,
+        x: &[f64],
+        grad: &mut [f64],
+    ) -> Result<Option<f64>, kappe_reliability::EvalError> {
+        self.eval(x, grad).map(Some)
     }
 }
 
@@ -207,11 +339,6 @@ fn state_checks(
     schedule: &crate::schedule::Schedule,
     v: Vars,
 ) -> Result<Vec<(usize, f64, Vec<Check>)>, DesignError> {
-    let options = &analysis.options;
-    let phi = cap.design.print.start_arch_fraction;
-    let green = crate::analysis::green::CapGreen::with_schedule(cap, Some(schedule))?;
-    let green = (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
-    let k = &cap.design.constraints;
     let scale = analysis.states.iter().fold(0.0_f64, |m, s| {
         m.max(s.max_compression_stress_pa.abs())
             .max(s.max_tension_stress_pa.abs())
@@ -220,43 +347,200 @@ fn state_checks(
     let mut out = Vec::with_capacity(analysis.states.len());
     for s in &analysis.states {
         let t_hours = schedule.layers.get(s.index).map_or(0.0, |l| l.end_s) / 3600.0;
-        let mut checks = Vec::new();
-        if let Some(blf) = s.blf
-            && (v.gamma.is_some() || v.e.is_some() || v.nu.is_some())
-        {
-            let s_nu = if v.nu.is_some() {
-                // ∂BLF/∂ν by a central difference of two re-solves (see the module docs).
-                let state = build_state(&cap.sections, &cap.frame, phi, s.index)?;
-                let mut mat = state_material_with(cap, options, s.index, green.as_ref());
-                let mut f = [0.0; 2];
-                for (k, sign) in [1.0, -1.0].into_iter().enumerate() {
-                    mat.poisson_ratio = v.nu0 + sign * NU_STEP;
-                    let b = state_buckling(&state, &mat, options)?;
-                    f[k] = b.factors.first().copied().unwrap_or(blf);
-                }
-                (f[0] - f[1]) / (2.0 * NU_STEP) / blf
-            } else {
-                0.0
-            };
-            checks.push(Check::Buckling { blf, s_nu });
-        }
-        if v.gamma.is_some() {
-            // A stress check is random only when its sign can change with γ > 0: σ_min < 0 and a
-            // compression above the deterministic tolerance; σ_max > 0 and a tension above it
-            // (with σ_max = 0 a tension fails, and round-off passes, whatever γ is).
-            if s.max_compression_stress_pa < -stol && k.sigma_min < 0.0 {
-                checks.push(Check::Compression(s.max_compression_stress_pa));
-            }
-            if s.max_tension_stress_pa > stol && k.sigma_max > 0.0 {
-                checks.push(Check::Tension(s.max_tension_stress_pa));
-            }
-            if let Some(u) = s.strength_utilisation.filter(|u| *u > 0.0) {
-                checks.push(Check::Strength(u));
-            }
-        }
+        let checks = checks_of(
+            cap,
+            &analysis.options,
+            schedule,
+            v,
+            StateValues {
+                index: s.index,
+                blf: s.blf,
+                stresses: Some((s.max_compression_stress_pa, s.max_tension_stress_pa, stol)),
+                strength: s.strength_utilisation,
+            },
+        )?;
         out.push((s.index, t_hours, checks));
     }
     Ok(out)
+}
+
+/// The deterministic results of one state that its random checks start from.
+#[derive(Debug, Clone, Copy)]
+pub struct StateValues {
+    /// State index (top print index).
+    pub index: usize,
+    /// BLF at the design's values (None: no shell).
+    pub blf: Option<f64>,
+    /// σ_min,q,₀, σ_max,q,₀ and the tolerance below which a stress is round-off (None: the
+    /// stress checks are not part of this evaluation, e.g. in `kappe schedule`, where the waits
+    /// cannot change them).
+    pub stresses: Option<(f64, f64, f64)>,
+    /// Mohr–Coulomb utilisation u₀ (None: no strength model).
+    pub strength: Option<f64>,
+}
+
+/// The checks of one state that a random variable enters (see the module docs), on the
+/// schedule that sets its layers' ages (the ν re-solves use them).
+///
+/// # Errors
+/// A state that cannot be built or a failed ν re-solve.
+pub fn checks_of(
+    cap: &Cap,
+    options: &super::AnalysisOptions,
+    schedule: &crate::schedule::Schedule,
+    v: Vars,
+    s: StateValues,
+) -> Result<Vec<Check>, DesignError> {
+    let k = &cap.design.constraints;
+    let mut checks = Vec::new();
+    if let Some(blf) = s.blf
+        && (v.gamma.is_some() || v.e.is_some() || v.nu.is_some() || v.has_time())
+    {
+        let s_nu = if v.nu.is_some() {
+            // ∂BLF/∂ν by a central difference of two re-solves (see the module docs).
+            let green = crate::analysis::green::CapGreen::with_schedule(cap, Some(schedule))?;
+            let green =
+                (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
+            let phi = cap.design.print.start_arch_fraction;
+            let state = build_state(&cap.sections, &cap.frame, phi, s.index)?;
+            let mut mat = state_material_with(cap, options, s.index, green.as_ref());
+            let mut f = [0.0; 2];
+            for (k, sign) in [1.0, -1.0].into_iter().enumerate() {
+                mat.poisson_ratio = v.nu0 + sign * NU_STEP;
+                let b = state_buckling(&state, &mat, options)?;
+                f[k] = b.factors.first().copied().unwrap_or(blf);
+            }
+            (f[0] - f[1]) / (2.0 * NU_STEP) / blf
+        } else {
+            0.0
+        };
+        checks.push(if v.has_time() {
+            Check::BucklingTime {
+                blf,
+                s_nu,
+                top: s.index,
+            }
+        } else {
+            Check::Buckling { blf, s_nu }
+        });
+    }
+    if v.gamma.is_some() {
+        // A stress check is random only when its sign can change with γ > 0: σ_min < 0 and a
+        // compression above the deterministic tolerance; σ_max > 0 and a tension above it
+        // (with σ_max = 0 a tension fails, and round-off passes, whatever γ is).
+        if let Some((smin, smax, stol)) = s.stresses {
+            if smin < -stol && k.sigma_min < 0.0 {
+                checks.push(Check::Compression(smin));
+            }
+            if smax > stol && k.sigma_max > 0.0 {
+                checks.push(Check::Tension(smax));
+            }
+        }
+        if let Some(u) = s.strength.filter(|u| *u > 0.0) {
+            checks.push(Check::Strength(u));
+        }
+    }
+    Ok(checks)
+}
+
+/// A design's uncertain model, its drifts and where the variables sit.
+pub type Prepared = (Model, Vec<(String, Drift)>, Vars);
+
+/// FORM results of one state: its reliability and each check's FORM result by check name.
+pub type StateForm = (StateReliability, Vec<(&'static str, FormResult)>);
+
+/// The uncertain model of a design, its drifts and where the variables sit: what every state's
+/// FORM needs. None without `[uncertainty]`.
+///
+/// # Errors
+/// An invalid `[uncertainty]`.
+pub fn prepare(cap: &Cap) -> Result<Option<Prepared>, DesignError> {
+    let Some(table) = &cap.design.uncertainty else {
+        return Ok(None);
+    };
+    let model = table.model(&cap.design)?;
+    let v = Vars::of(&model, cap);
+    Ok(Some((model, table.drifts(), v)))
+}
+
+/// FORM of every check of one state printed at `t_hours` (the model drifted to that time), and
+/// the state's β and P_f as a series system of its checks. None when no check is random.
+/// The one implementation behind the run's reliability and `kappe schedule`'s β target.
+///
+/// # Errors
+/// A drift factor that is not positive at `t_hours`, a failed re-solve, or FORM that does not
+/// converge.
+#[allow(clippy::too_many_arguments)]
+pub fn state_form(
+    cap: &Cap,
+    options: &super::AnalysisOptions,
+    schedule: &crate::schedule::Schedule,
+    (model, drifts, v): (&Model, &[(String, Drift)], Vars),
+    index: usize,
+    t_hours: f64,
+    checks: &[Check],
+) -> Result<Option<StateForm>, DesignError> {
+    if checks.is_empty() {
+        return Ok(None);
+    }
+    let k = &cap.design.constraints;
+    let limits = (k.sigma_min, k.sigma_max, k.blf_min);
+    let seed = cap
+        .design
+        .uncertainty
+        .as_ref()
+        .and_then(|t| t.seed)
+        .unwrap_or(0);
+    let state_model = model
+        .drifted(drifts, t_hours)
+        .map_err(|e| DesignError::Uncertainty {
+            field: "uncertainty.drift".into(),
+            message: format!("state {index} at {t_hours:.3} h: {e}"),
+        })?;
+    let mut by_check = BTreeMap::new();
+    let mut own = Vec::new();
+    let mut results = Vec::new();
+    for &check in checks {
+        let r = match check {
+            Check::BucklingTime { blf, s_nu, top } => {
+                let mut g = TimeBuckling {
+                    cap,
+                    options,
+                    schedule,
+                    time: cap.design.time_model()?,
+                    vars: v,
+                    check: (blf, s_nu, top),
+                    blf_min: k.blf_min,
+                    shell0: None,
+                };
+                form(&state_model, &mut g, &FormOptions::default())
+            }
+            _ => check_form(&state_model, check, v, limits),
+        }
+        .map_err(rel_err)?;
+        by_check.insert(check.name().to_owned(), r.beta);
+        own.push(Component::from(&r));
+        results.push((check.name(), r));
+    }
+    let sys = series_system(
+        &own,
+        &SystemOptions {
+            samples: STATE_SYSTEM_SAMPLES,
+            seed,
+            ditlevsen: false,
+        },
+    )
+    .map_err(rel_err)?;
+    Ok(Some((
+        StateReliability {
+            index,
+            t_hours,
+            beta: sys.beta,
+            pf: sys.pf,
+            beta_by_check: by_check,
+        },
+        results,
+    )))
 }
 
 fn rel_err(e: kappe_reliability::Error) -> DesignError {
@@ -295,47 +579,34 @@ pub fn reliability(
     let drifts = table.drifts();
     let v = Vars::of(&model, cap);
     let k = &cap.design.constraints;
-    let limits = (k.sigma_min, k.sigma_max, k.blf_min);
     let per_state = state_checks(cap, analysis, schedule, v)?;
     let mut components: Vec<Component> = Vec::new();
     let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
     let mut states = Vec::new();
-    for (index, t_hours, checks) in per_state {
-        if checks.is_empty() {
-            continue;
+    // States are independent (each its own FORM, its own re-solves): in parallel, collected in
+    // state order, so the result is the sequential one bit for bit.
+    use rayon::prelude::*;
+    let per_state: Vec<_> = per_state
+        .par_iter()
+        .map(|(index, t_hours, checks)| {
+            state_form(
+                cap,
+                &analysis.options,
+                schedule,
+                (&model, &drifts, v),
+                *index,
+                *t_hours,
+                checks,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    for (state, rs) in per_state.into_iter().flatten() {
+        let index = state.index;
+        for (name, r) in rs {
+            components.push(Component::from(&r));
+            results.push((index, name, r));
         }
-        let state_model =
-            model
-                .drifted(&drifts, t_hours)
-                .map_err(|e| DesignError::Uncertainty {
-                    field: "uncertainty.drift".into(),
-                    message: format!("state {index} at {t_hours:.3} h: {e}"),
-                })?;
-        let mut by_check = BTreeMap::new();
-        let mut own = Vec::new();
-        for check in checks {
-            let r = check_form(&state_model, check, v, limits).map_err(rel_err)?;
-            by_check.insert(check.name().to_owned(), r.beta);
-            own.push(Component::from(&r));
-            results.push((index, check.name(), r));
-        }
-        let sys = series_system(
-            &own,
-            &SystemOptions {
-                samples: STATE_SYSTEM_SAMPLES,
-                seed: table.seed.unwrap_or(0),
-                ditlevsen: false,
-            },
-        )
-        .map_err(rel_err)?;
-        components.extend(own);
-        states.push(StateReliability {
-            index,
-            t_hours,
-            beta: sys.beta,
-            pf: sys.pf,
-            beta_by_check: by_check,
-        });
+        states.push(state);
     }
     if components.is_empty() {
         return Err(DesignError::Uncertainty {

@@ -14,6 +14,16 @@
 //! even `wait_max` does not help (the top layer itself, at age 0, fails; or the wait is bounded),
 //! the state is reported as infeasible with its binding check. Every check only improves with
 //! age in the time models of [`crate::input::material`] (non-negative rates), which the bisection needs.
+//!
+//! **β target (issue 24).** With `[uncertainty]` a state passes only when, besides the
+//! deterministic checks, its reliability index β (FORM of its random checks as a series system,
+//! [`crate::analysis::reliability::state_form`], the function the run's reliability uses) reaches
+//! `constraints.beta_min` (default [`crate::input::uncertainty::BETA_MIN_DEFAULT`]). The state's
+//! variables are drifted to its print time on the schedule being tried, so a drying mix is
+//! followed exactly: a wait ages the layers below (stiffer) but prints the top later (drifted).
+//! β then need not grow with the wait when the drift outpaces the ageing; the bisection assumes
+//! it does, and the final plan's states are re-checked (`states`) so a miss shows there. The
+//! stress checks of the force pass are left out here: no wait changes them.
 
 use serde::Serialize;
 
@@ -38,7 +48,9 @@ pub struct StateCheck {
     pub sliding: Option<f64>,
     /// The check with the largest utilisation (BLF_min/BLF for buckling).
     pub governing: Option<FailureMode>,
-    /// All pass.
+    /// β of the state under `[uncertainty]` (None: no table, or no random check).
+    pub beta: Option<f64>,
+    /// All pass (and β ≥ β_min with `[uncertainty]`).
     pub pass: bool,
 }
 
@@ -49,8 +61,10 @@ pub struct Binding {
     pub state: usize,
     /// Wait after layer `state − 1`, s.
     pub wait_s: f64,
-    /// The check that failed without it.
+    /// The check that failed without it (the governing one when only β fell short).
     pub check: Option<FailureMode>,
+    /// β without the wait (with `[uncertainty]`).
+    pub beta_before: Option<f64>,
 }
 
 /// The least-time schedule.
@@ -68,6 +82,8 @@ pub struct WaitPlan {
     pub infeasible: Vec<StateCheck>,
     /// Every state's check with the final waits.
     pub states: Vec<StateCheck>,
+    /// The β target (None without `[uncertainty]`).
+    pub beta_min: Option<f64>,
 }
 
 /// Check the state with top print index `top` on `schedule`.
@@ -112,14 +128,48 @@ pub fn check_state_on(
         .iter()
         .filter_map(|(m, u)| u.map(|u| (*m, u)))
         .max_by(|a, b| a.1.total_cmp(&b.1));
+    let beta = match crate::analysis::reliability::prepare(cap)? {
+        Some((model, drifts, v)) => {
+            use crate::analysis::reliability::{StateValues, checks_of, state_form};
+            let values = StateValues {
+                index: top,
+                blf,
+                stresses: None,
+                strength: st.map(|w| w.utilisation),
+            };
+            let checks = checks_of(cap, options, schedule, v, values)?;
+            let t_hours = schedule.layers.get(top).map_or(0.0, |l| l.end_s) / 3600.0;
+            state_form(
+                cap,
+                options,
+                schedule,
+                (&model, &drifts, v),
+                top,
+                t_hours,
+                &checks,
+            )?
+            .map(|(r, _)| r.beta)
+        }
+        None => None,
+    };
+    let beta_ok = beta.is_none_or(|b| b >= beta_min(cap));
     Ok(StateCheck {
         state: top,
         blf,
         strength: st.map(|w| w.utilisation),
         sliding: sl.map(|w| w.utilisation),
         governing: governing.map(|g| g.0),
-        pass: governing.is_none_or(|g| g.1 <= 1.0),
+        beta,
+        pass: governing.is_none_or(|g| g.1 <= 1.0) && beta_ok,
     })
+}
+
+/// The β target of a design: `constraints.beta_min` or the default.
+fn beta_min(cap: &Cap) -> f64 {
+    cap.design
+        .constraints
+        .beta_min
+        .unwrap_or(crate::input::uncertainty::BETA_MIN_DEFAULT)
 }
 
 /// Find the least waits (see the module docs). `wait_max` bounds each wait, s.
@@ -175,6 +225,7 @@ pub fn least_waits(
                     state: top,
                     wait_s: hi - before,
                     check: c.governing,
+                    beta_before: c.beta,
                 });
                 schedule = best.0;
                 c = best.1;
@@ -196,6 +247,7 @@ pub fn least_waits(
         binding,
         infeasible,
         states,
+        beta_min: cap.design.uncertainty.as_ref().map(|_| beta_min(cap)),
     })
 }
 
@@ -231,9 +283,12 @@ pub fn text_report(plan: &WaitPlan, wait_max: f64) -> String {
         plan.schedule.total_wait_s()
     );
     for b in &plan.binding {
+        let beta = b
+            .beta_before
+            .map_or(String::new(), |v| format!("; β {v:.2} without it"));
         let _ = writeln!(
             t,
-            "  state {:>4}: wait {:.1} s before its top layer ({} binds)",
+            "  state {:>4}: wait {:.1} s before its top layer ({} binds{beta})",
             b.state,
             b.wait_s,
             b.check.map_or("-", |m| m.name())
@@ -242,13 +297,14 @@ pub fn text_report(plan: &WaitPlan, wait_max: f64) -> String {
     for c in &plan.infeasible {
         let _ = writeln!(
             t,
-            "  state {:>4}: FAILS even with {:.0} s of wait ({} governs; BLF {:?}, strength {:?}, sliding {:?})",
+            "  state {:>4}: FAILS even with {:.0} s of wait ({} governs; BLF {:?}, strength {:?}, sliding {:?}, β {:?})",
             c.state,
             wait_max,
             c.governing.map_or("-", |m| m.name()),
             c.blf,
             c.strength,
-            c.sliding
+            c.sliding,
+            c.beta
         );
     }
     let list: Vec<String> = plan
@@ -257,6 +313,17 @@ pub fn text_report(plan: &WaitPlan, wait_max: f64) -> String {
         .iter()
         .map(|l| format!("{:.1}", l.wait_s))
         .collect();
+    if let Some(bm) = plan.beta_min {
+        let low = plan
+            .states
+            .iter()
+            .filter_map(|c| c.beta)
+            .fold(f64::INFINITY, f64::min);
+        let _ = writeln!(
+            t,
+            "β target {bm:.2}: lowest state β with these waits {low:.2} (drift included)"
+        );
+    }
     let _ = writeln!(t, "add to the design to print and check this schedule:");
     let _ = writeln!(t, "[schedule]\nwaits = [{}]", list.join(", "));
     t

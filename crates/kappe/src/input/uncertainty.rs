@@ -34,10 +34,20 @@ use crate::input::error::DesignError;
 pub const BETA_MIN_DEFAULT: f64 = 2.3;
 
 /// The names `[uncertainty]` accepts, whether each is positive, and how it enters the analysis.
-pub const PARAMETERS: [(&str, bool); 3] = [
+pub const PARAMETERS: [(&str, bool); 5] = [
     ("material.specific_weight", false),
     ("material.youngs_modulus", true),
     ("material.poisson_ratio", true),
+    ("material.time.youngs_modulus", true),
+    ("material.time.youngs_modulus_rate", true),
+];
+
+/// The time model's parameters among [`PARAMETERS`]: they set every layer's modulus by its age,
+/// so they enter the buckling check through re-solves with exact eigenvalue sensitivities
+/// (`crate::analysis::blf_sensitivity`), not through a scaling.
+pub const TIME_PARAMETERS: [&str; 2] = [
+    "material.time.youngs_modulus",
+    "material.time.youngs_modulus_rate",
 ];
 
 /// The `[uncertainty]` table; see the module docs.
@@ -75,6 +85,15 @@ pub fn nominal(design: &Design, name: &str) -> Option<f64> {
         "material.specific_weight" => Some(m.specific_weight),
         "material.youngs_modulus" => Some(m.youngs_modulus),
         "material.poisson_ratio" => Some(m.poisson_ratio),
+        "material.time.youngs_modulus" | "material.time.youngs_modulus_rate" => {
+            let has_time = m.time.is_some() || design.analysis.ageing.is_some();
+            let t = design.time_model().ok().filter(|_| has_time)?;
+            Some(if name.ends_with("_rate") {
+                t.youngs_modulus.rate
+            } else {
+                t.youngs_modulus.initial
+            })
+        }
         _ => None,
     }
 }
@@ -99,7 +118,15 @@ impl UncertaintyTable {
                 ),
             ));
         }
+        let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
         let known = |name: &str, context: &str| -> Result<(), DesignError> {
+            if TIME_PARAMETERS.contains(&name) && !time_model {
+                return Err(err(
+                    format!("{context}\"{name}\""),
+                    "a time-model parameter needs a time model: give [material.time] \
+                     (e.g. model = \"linear\" with youngs_modulus_rate)",
+                ));
+            }
             if nominal(design, name).is_some() {
                 Ok(())
             } else {
@@ -123,13 +150,12 @@ impl UncertaintyTable {
                 .map_err(|e| err(format!("uncertainty.\"{name}\""), e))?;
             variables.push(v);
         }
-        let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
         if time_model && self.parameters.contains_key("material.youngs_modulus") {
             return Err(err(
                 "uncertainty.\"material.youngs_modulus\"".into(),
                 "the design has a time model ([material.time] or [analysis.ageing]), whose \
-                 moduli do not use material.youngs_modulus; uncertainty of the time model's \
-                 parameters is not supported yet (issue 24)",
+                 moduli do not use material.youngs_modulus; give the time model's own \
+                 \"material.time.youngs_modulus\" and \"material.time.youngs_modulus_rate\"",
             ));
         }
         let mut pairs = Vec::new();

@@ -185,3 +185,239 @@ fn reliability_only_with_the_table() {
         out_u.analysis.as_ref().map(|a| a.constraints.clone())
     );
 }
+
+/// A 0.6 m × 0.8 m wall, 2 cm thick, clamped at its base under its own weight, whose element rows
+/// have the moduli of printed layers of different ages: E(row j) = E₀ + Ė·age_j, age_j = 60 s
+/// per row below the top. Returns the model and each element's age.
+fn aged_wall(e0: f64, rate: f64) -> (kappe_fe::ShellModel, Vec<f64>) {
+    let (nx, ny, w, h) = (6, 8, 0.6, 0.8);
+    let mut nodes = Vec::new();
+    for j in 0..=ny {
+        for i in 0..=nx {
+            nodes.push([w * i as f64 / nx as f64, 0.0, h * j as f64 / ny as f64]);
+        }
+    }
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let (mut tris, mut ages) = (Vec::new(), Vec::new());
+    for j in 0..ny {
+        let age = 60.0 * (ny - 1 - j) as f64;
+        for i in 0..nx {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            ages.extend([age, age]);
+        }
+    }
+    let base = kappe_fe::Material {
+        youngs_modulus: e0,
+        poisson_ratio: 0.3,
+        unit_weight: 2.0e4,
+    };
+    let mut m = kappe_fe::ShellModel::new(nodes, tris, 0.02, base);
+    m.materials = ages
+        .iter()
+        .map(|a| kappe_fe::Material {
+            youngs_modulus: e0 + rate * a,
+            ..base
+        })
+        .collect();
+    m.supports = (0..=nx).map(kappe_fe::Support::clamped).collect();
+    (m, ages)
+}
+
+/// Tight Lanczos residual for the finite differences: the factor's error is of the order of its
+/// square, so the difference quotient's round-off stays near 1e-12/step ≪ 1e-5.
+fn tight_blf(m: &kappe_fe::ShellModel) -> kappe_fe::BucklingResult {
+    kappe_fe::buckling(
+        m,
+        &kappe_fe::BucklingOptions {
+            modes: 1,
+            tolerance: 1e-12,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
+
+/// dλ/dE₀ and dλ/dĖ of the aged wall (eigenvalue sensitivity with ∂K_G/∂p from the force
+/// redistribution) against central finite differences of re-solves, relative 1e-5 (issue 24's
+/// verification). Step 1e-4 of each parameter: the central difference's truncation error is
+/// O(step²) ≈ 1e-8 relative, its round-off ≈ 1e-12/1e-4 = 1e-8. Also Euler's identity for a
+/// modulus linear in (E₀, Ė): E₀·∂λ/∂E₀ + Ė·∂λ/∂Ė = λ (λ is homogeneous of degree 1 in them).
+#[test]
+fn blf_sensitivity_of_an_aged_wall_matches_finite_differences() {
+    let (e0, rate) = (1.0e5, 150.0);
+    let (m, ages) = aged_wall(e0, rate);
+    let r = tight_blf(&m);
+    let lambda = r.factors[0];
+    let de = vec![vec![1.0; ages.len()], ages.clone()];
+    let d = kappe::analysis::blf_sensitivity::blf_derivatives(
+        &m,
+        lambda,
+        &r.modes[0],
+        &r.static_result,
+        &de,
+    )
+    .unwrap();
+    for (k, (p, name)) in [(e0, "E0"), (rate, "rate")].into_iter().enumerate() {
+        let h = 1e-4 * p;
+        let at = |s: f64| {
+            let (e, ra) = if k == 0 {
+                (e0 + s * h, rate)
+            } else {
+                (e0, rate + s * h)
+            };
+            tight_blf(&aged_wall(e, ra).0).factors[0]
+        };
+        let fd = (at(1.0) - at(-1.0)) / (2.0 * h);
+        assert!(
+            (d[k] / fd - 1.0).abs() < 1e-5,
+            "dλ/d{name}: sensitivity {} vs central difference {fd}",
+            d[k]
+        );
+    }
+    let euler = e0 * d[0] + rate * d[1];
+    assert!(
+        (euler / lambda - 1.0).abs() < 1e-6,
+        "E0·dλ/dE0 + Ė·dλ/dĖ = {euler} vs λ = {lambda}"
+    );
+}
+
+/// A cap state with a linear time model: dλ/dE₀ and dλ/dĖ of the analysis' shell (the function
+/// the reliability analysis calls) against central differences of the same function's λ,
+/// relative 1e-5 (steps and tolerance as for the wall).
+#[test]
+fn blf_sensitivity_of_a_cap_state_matches_finite_differences() {
+    let mut d = small();
+    d.material.time = Some(kappe::input::material::TimeModelSpec {
+        model: Some(kappe::input::material::TimeLaw::Linear),
+        youngs_modulus: Some(2.0e6),
+        youngs_modulus_rate: Some(2.0e4),
+        ..Default::default()
+    });
+    let cap = design_cap(&d, &|_| {}).unwrap();
+    let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+    let last = cap.states.len() - 1;
+    let time = d.time_model().unwrap();
+    let solve = |t: &kappe::input::material::TimeModel| {
+        kappe::analysis::blf_sensitivity::time_state_blf(
+            &cap,
+            &d.analysis,
+            &green.schedule,
+            t,
+            last,
+            1e-12,
+        )
+        .unwrap()
+        .unwrap()
+    };
+    let (lambda, dl) = solve(&time);
+    let ages = green.schedule.ages(last + 1);
+    assert!(
+        ages[0] > 60.0,
+        "the bottom layer's age {} s makes the moduli non-uniform",
+        ages[0]
+    );
+    for (k, dk) in dl.into_iter().enumerate() {
+        let p = if k == 0 {
+            time.youngs_modulus.initial
+        } else {
+            time.youngs_modulus.rate
+        };
+        let h = 1e-4 * p;
+        let at = |s: f64| {
+            let mut t = time.clone();
+            if k == 0 {
+                t.youngs_modulus.initial += s * h;
+            } else {
+                t.youngs_modulus.rate += s * h;
+            }
+            solve(&t).0
+        };
+        let fd = (at(1.0) - at(-1.0)) / (2.0 * h);
+        assert!(
+            (dk / fd - 1.0).abs() < 1e-5,
+            "state {last}, parameter {k}: sensitivity {dk} vs central difference {fd} (λ {lambda})"
+        );
+    }
+}
+
+/// The small cap printed slowly (44 states, 57 min) from a mix whose modulus grows with age,
+/// E(t) = 1.3 MPa + 400 Pa/s·t, with E₀ lognormal (coefficient of variation 0.15) and, when
+/// `percent_per_hour` is given, drifting at that rate.
+fn study14(percent_per_hour: Option<f64>) -> Design {
+    let mut d = small();
+    d.print.print_speed = 0.01;
+    let drift = percent_per_hour.map_or(String::new(), |r| {
+        format!(
+            "[uncertainty.drift]\n\"material.time.youngs_modulus\" = {{ percent_per_hour = {r:?} }}\n"
+        )
+    });
+    let u = with_uncertainty(&format!(
+        "[material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
+         [uncertainty]\n\"material.time.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}\n{drift}"
+    ))
+    .unwrap();
+    d.material.time = u.material.time;
+    d.uncertainty = u.uncertainty;
+    d
+}
+
+/// Study No. 14's story (the paper: a cap that met every constraint collapsed as the mix dried
+/// over the testing period). The cap passes on nominal values and keeps β ≥ β_min = 2.3 with a
+/// steady mix; a mix drying at −20 %/h (E₀ falls 19 % over the print) pulls the last states'
+/// β below the target; `kappe schedule`'s least waits with the same drift bring every state
+/// back to β ≥ β_min (each state re-checked on the final schedule).
+#[test]
+fn study14_drying_mix_and_the_waits_that_keep_beta() {
+    use kappe::commands::least_waits::{check_state_on, least_waits};
+    let beta_min = kappe::input::uncertainty::BETA_MIN_DEFAULT;
+    // Nominal values: every state passes without a wait.
+    let mut nominal = study14(None);
+    nominal.uncertainty = None;
+    let cap = design_cap(&nominal, &|_| {}).unwrap();
+    let plan = least_waits(&cap, &nominal.analysis, 0.0, &|_| {}).unwrap();
+    assert!(
+        plan.infeasible.is_empty() && plan.states.iter().all(|c| c.pass),
+        "nominal fails: {:?}",
+        plan.infeasible
+    );
+    // The last states govern (the cap's BLF falls towards its completion, BLF₀ of the last
+    // state 1.39); the earlier ones have β > 4 either way.
+    let last_betas = |d: &Design| -> Vec<f64> {
+        let cap = design_cap(d, &|_| {}).unwrap();
+        let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+        let n = cap.states.len();
+        (n - 4..n)
+            .map(|q| {
+                check_state_on(&cap, &green, &d.analysis, &green.schedule, q)
+                    .unwrap()
+                    .beta
+                    .unwrap()
+            })
+            .collect()
+    };
+    let steady = last_betas(&study14(None));
+    assert!(
+        steady.iter().all(|b| *b >= beta_min),
+        "steady mix: β {steady:?} below {beta_min}"
+    );
+    let drying = study14(Some(-20.0));
+    let dried = last_betas(&drying);
+    let low = dried.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(low < beta_min, "drying mix: β {dried:?} all ≥ {beta_min}");
+    // The least waits with the same drift.
+    let cap = design_cap(&drying, &|_| {}).unwrap();
+    let plan = least_waits(&cap, &drying.analysis, 600.0, &|_| {}).unwrap();
+    assert!(plan.infeasible.is_empty(), "{:?}", plan.infeasible);
+    assert!(plan.schedule.total_wait_s() > 0.0, "no wait was needed");
+    let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+    for q in 0..cap.states.len() {
+        let c = check_state_on(&cap, &green, &drying.analysis, &plan.schedule, q).unwrap();
+        assert!(c.pass, "state {q} on the final schedule: {c:?}");
+        assert!(
+            c.beta.is_none_or(|b| b >= beta_min),
+            "state {q}: β {:?} < {beta_min}",
+            c.beta
+        );
+    }
+}
