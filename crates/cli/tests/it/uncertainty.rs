@@ -35,3 +35,36 @@ fn schedule_keeps_beta_above_the_target_with_a_drifting_mix() {
         }
     }
 }
+
+/// One verdict in the terminal (issue 22): the same drifting cap, designed without waits, passes
+/// every structural constraint on nominal values but its print's β falls below 2.3 — the
+/// terminal says FAILS with the β line and its levers (it used to print "passes every
+/// constraint" while summary.json failed), exit 1, and summary.json agrees.
+#[test]
+fn a_print_below_its_beta_target_fails_in_the_terminal_too() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("cap.toml"),
+        "[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\nprint_speed = 0.01\n\
+         [robot]\nenabled = false\n[analysis]\nrow_stride = 8\n\
+         [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
+         [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+    )
+    .unwrap();
+    let o = kappe(dir.path(), &["design", "cap.toml", "--out", "out"]);
+    let stdout = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{stdout}\n{}", text(&o.stderr));
+    assert!(!stdout.contains("passes every constraint"), "{stdout}");
+    assert!(stdout.contains("design FAILS"), "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .any(|l| l.trim_start().starts_with("beta_min") && l.contains("FAIL")),
+        "{stdout}"
+    );
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(s["ok"], false);
+}

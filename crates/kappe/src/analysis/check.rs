@@ -168,6 +168,18 @@ impl Analysis {
     /// mm, plain factors: [`readable`]) and, for a failing constraint, what to change
     /// ([`levers`]).
     pub fn report(&self) -> String {
+        let mut s = self.constraint_lines();
+        s.push_str(if self.ok {
+            "design passes every constraint\n"
+        } else {
+            "design FAILS\n"
+        });
+        s
+    }
+
+    /// [`Analysis::report`] without its last line (the analysis' own pass or fail): for a
+    /// caller whose verdict also weighs other checks (`kappe design`: reliability, the robot).
+    pub fn constraint_lines(&self) -> String {
         let mut s = String::new();
         for c in &self.constraints {
             let worst = c
@@ -186,11 +198,6 @@ impl Analysis {
                 s.push_str(&format!("{:<18} to fix: {}\n", "", levers(c.name)));
             }
         }
-        s.push_str(if self.ok {
-            "design passes every constraint\n"
-        } else {
-            "design FAILS\n"
-        });
         s
     }
 }
@@ -238,6 +245,12 @@ pub fn levers(name: &str) -> &'static str {
             "the imperfect state collapses (docs/collapse.md): raise cap.rise, widen the layers \
              (print.layer_width), wait between layers so they stiffen and strengthen (`kappe \
              schedule`), or measure your placement tolerance and imperfection"
+        }
+        "beta_min" => {
+            "the print stands with too little certainty for the stated scatter (docs/reliability.md): \
+             the sensitivities in summary.json's reliability block name the parameter that matters; \
+             measure it more tightly, or add margin (cap.rise, print.layer_width, waits from \
+             `kappe schedule`, which targets β)"
         }
         _ => "see the report (report.html) for the governing state",
     }
@@ -563,7 +576,8 @@ pub fn analyze_given(
         .iter()
         .map(Vec::len)
         .sum();
-    let interpolated = if fe.len() >= selected {
+    let complete = fe.len() >= selected;
+    let interpolated = if complete {
         converge_fe(options, &mut fe, &mut |states, opts| {
             solve_states(cap, opts, green.as_ref(), states)
         })?
@@ -577,6 +591,7 @@ pub fn analyze_given(
         fe,
         &interpolated,
         (t_all, 0.0),
+        complete,
         &AtomicBool::new(false),
     )
 }
@@ -691,13 +706,17 @@ pub(crate) fn analyze_scheduled(
         fe,
         &interpolated,
         (t_all, wall_fe),
+        true,
         stop,
     )
 }
 
 /// Phase 1 (every state's force pass and element stresses) and the report of [`analyze`], with
 /// the finite-element results `fe`; `clock`: when the analysis started and the wall-clock
-/// seconds of the finite-element phase.
+/// seconds of the finite-element phase. `complete`: every selected state is in `fe`, so the
+/// whole-print passes run (the as-printed shape; a partial verdict, the designer's while its
+/// workers run, leaves them out rather than pay for them at every result).
+#[allow(clippy::too_many_arguments)]
 fn assemble(
     cap: &Cap,
     options: &AnalysisOptions,
@@ -705,6 +724,7 @@ fn assemble(
     fe: Vec<StateFe>,
     interpolated: &[usize],
     (t_all, wall_fe): (Instant, f64),
+    complete: bool,
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     let cancelled = || {
@@ -984,7 +1004,7 @@ fn assemble(
     // The as-printed shape (docs/as-printed.md): every state's increment under its new weight.
     let t_printed = Instant::now();
     let deviation_max = design.deviation_max();
-    let as_printed = if options.buckling && total > 0 {
+    let as_printed = if options.buckling && total > 0 && complete {
         let a =
             crate::analysis::asprinted::cap_as_printed(cap, options, green.as_ref(), &cancelled)?;
         for (s, d) in states.iter_mut().zip(&a.states) {

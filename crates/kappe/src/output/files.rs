@@ -310,9 +310,33 @@ impl Outcome {
             out.display()
         );
         if let Some(analysis) = &self.analysis {
-            for line in analysis.report().lines() {
+            for line in analysis.constraint_lines().lines() {
                 let _ = writeln!(t, "  {line}");
             }
+            // The one verdict (issue 22): the constraints, the print's reliability (issue 24)
+            // and the robot's checks, not the analysis' constraints alone.
+            if let Some(r) = self.reliability.as_ref().filter(|r| r.beta < r.beta_min) {
+                let _ = writeln!(
+                    t,
+                    "  {:<13} FAIL limit {:.2}, worst {:.2} at state {}, {}\n  {:<18} to fix: {}",
+                    "beta_min",
+                    r.beta_min,
+                    r.beta,
+                    r.governing_state,
+                    r.governing_check,
+                    "",
+                    crate::analysis::check::levers("beta_min")
+                );
+            }
+            let _ = writeln!(
+                t,
+                "  {}",
+                if self.verdict.ok {
+                    "design passes every constraint"
+                } else {
+                    "design FAILS"
+                }
+            );
         }
         let _ = match &self.robot {
             Some(Ok(plan)) => writeln!(
