@@ -244,7 +244,7 @@ fn failed_constraints_are_marked_in_the_report() {
     let html = std::fs::read_to_string(work.join("s/designs/weak/report.html")).unwrap();
     let input = island(&html);
     // Without an [analysis] table the study analyses as `kappe design` does (buckling on), so
-    // the BLF row follows the three preliminary ones, then the robot's.
+    // the BLF and as-printed rows follow the three preliminary ones, then the robot's.
     let names: Vec<&str> = input.constraints.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(
         names,
@@ -253,6 +253,7 @@ fn failed_constraints_are_marked_in_the_report() {
             "sigma_max",
             "overhang_max",
             "blf_min",
+            "deviation_max",
             "robot_plan",
             "base_tolerance"
         ]
@@ -270,5 +271,5 @@ fn failed_constraints_are_marked_in_the_report() {
     assert!(element.starts_with("layer -"), "{element}");
     assert!(input.states.iter().any(|s| !s.ok));
     let failing = input.constraints.iter().filter(|c| !c.pass).count();
-    assert!(html.contains(&format!("FAIL: {failing} of 6 constraints violated")));
+    assert!(html.contains(&format!("FAIL: {failing} of 7 constraints violated")));
 }
