@@ -626,21 +626,12 @@ pub fn verify_meshes_moving(
     let plan = &mp.plan;
     let meshes = ArmMeshes::load()?;
     let layers = crate::check::plan_layers(plan);
-    let mut world_setup = plan.setup.clone();
-    world_setup.mobile_base.clear();
-    let ctx = validate(&layers, &world_setup, &plan.options)?;
-    let world = ctx.scene(&Iso::IDENTITY)?;
-    let boxes: Vec<_> = plan
-        .setup
-        .mobile_base
-        .iter()
-        .map(|b| b.to_world(&Iso::IDENTITY))
-        .collect();
-    let body = if boxes.is_empty() {
-        None
-    } else {
-        Some(crate::collision::Scene::new(&boxes)?)
-    };
+    // The moving check's own split: the world without the body, the body in the base frame.
+    let crate::moving::Geometry {
+        world: ctx,
+        scene: world,
+        body,
+    } = crate::moving::Geometry::new(&validate(&layers, &plan.setup, &plan.options)?)?;
     let tool_caps: Vec<_> = ctx
         .self_model
         .capsules

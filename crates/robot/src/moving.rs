@@ -429,14 +429,17 @@ fn front_sign(layers: &[PrintLayer]) -> f64 {
 /// World geometry shared by the rungs: the context without the mobile-base body (the body moves
 /// with the base and is checked in the base frame), its world scene, and the body in the base
 /// frame.
-struct Geometry {
-    world: Context,
-    scene: Scene,
-    body: Option<Scene>,
+pub(crate) struct Geometry {
+    /// The plan's context without the mobile base's body (the world's obstacles only).
+    pub(crate) world: Context,
+    /// The world's obstacles (beams, floor, printed layers).
+    pub(crate) scene: Scene,
+    /// The mobile base's body in the base frame (it moves with the arm).
+    pub(crate) body: Option<Scene>,
 }
 
 impl Geometry {
-    fn new(ctx: &Context) -> Result<Geometry, RobotError> {
+    pub(crate) fn new(ctx: &Context) -> Result<Geometry, RobotError> {
         let mut setup = ctx.setup.clone();
         setup.mobile_base.clear();
         let world = validate(&ctx.layers, &setup, &ctx.opts)?;

@@ -4,20 +4,20 @@
 use crate::common::{kappe, text};
 
 /// The small cap printed slowly from a mix whose modulus grows with age and drifts −20 %/h
+/// (the kappe crate's study No. 14 test).
+const DRIFTING_CAP: &str = "[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\nprint_speed = 0.01\n\
+     [robot]\nenabled = false\n[analysis]\nrow_stride = 8\n\
+     [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
+     [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+     [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n";
+
+/// The small cap printed slowly from a mix whose modulus grows with age and drifts −20 %/h
 /// (the kappe crate's study No. 14 test): some waits are needed, and schedule.json's every
 /// state reaches β ≥ 2.3 (the default target).
 #[test]
 fn schedule_keeps_beta_above_the_target_with_a_drifting_mix() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("cap.toml"),
-        "[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\nprint_speed = 0.01\n\
-         [robot]\nenabled = false\n[analysis]\nrow_stride = 8\n\
-         [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
-         [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
-         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("cap.toml"), DRIFTING_CAP).unwrap();
     let o = kappe(dir.path(), &["schedule", "cap.toml", "--out", "out"]);
     let stdout = text(&o.stdout);
     assert_eq!(o.status.code(), Some(0), "{stdout}\n{}", text(&o.stderr));
@@ -43,15 +43,7 @@ fn schedule_keeps_beta_above_the_target_with_a_drifting_mix() {
 #[test]
 fn a_print_below_its_beta_target_fails_in_the_terminal_too() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("cap.toml"),
-        "[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\nprint_speed = 0.01\n\
-         [robot]\nenabled = false\n[analysis]\nrow_stride = 8\n\
-         [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
-         [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
-         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("cap.toml"), DRIFTING_CAP).unwrap();
     let o = kappe(dir.path(), &["design", "cap.toml", "--out", "out"]);
     let stdout = text(&o.stdout);
     assert_eq!(o.status.code(), Some(1), "{stdout}\n{}", text(&o.stderr));
