@@ -6,7 +6,7 @@
 //!
 //! * [`Session`] (the page's main thread): the design as TOML text (what "Download design.toml"
 //!   saves), [`kappe::Design::from_toml_str`] (parse and validate), [`kappe::design_cap`]
-//!   (form-finding, every print state's forces), [`kappe::run::evaluate_given`] (stresses,
+//!   (form-finding, every print state's forces), [`kappe::run::evaluate`] (stresses,
 //!   overhangs, the constraint report and the verdict, from the buckling results handed in so
 //!   far).
 //! * [`Worker`] (one per Web Worker): [`kappe::analysis::check::state_fe`], the buckling
@@ -146,7 +146,7 @@ impl From<FeWire> for StateFe {
                 mechanism: w.mechanism,
                 shell_nodes: w.shell_nodes,
                 // A worker's result is the first pass (`state_fe`): the mesh error is estimated
-                // afterwards over all states (`converge_fe`, in `analyze_given`).
+                // afterwards over all states (`converge_fe`, in `kappe::analysis::analyze` with the results given).
                 convergence: None,
             },
             // The mode shape is not drawn by the designer (it is large); it enters no check.
@@ -282,7 +282,8 @@ impl SessionCore {
     /// The design's first problem, with the field it names.
     pub fn load(&mut self, text: &str) -> Result<Value, FieldError> {
         let design = Design::from_toml_str(text).map_err(|e| FieldError::of(&e))?;
-        let cap = kappe::design_cap(&design, &|_| {}).map_err(|e| FieldError::of(&e))?;
+        let cap = kappe::design_cap(&design, kappe::Context::default())
+            .map_err(|e| FieldError::of(&e))?;
         let runs = fe_runs(&design.analysis, cap.states.len());
         // The quick pass must succeed before the design is taken (e.g. a bad [schedule]).
         let outcome = evaluate(&cap, &BTreeMap::new()).map_err(|e| FieldError::of(&e))?;
@@ -336,7 +337,7 @@ impl SessionCore {
     }
 }
 
-/// The verdict of `cap` with the buckling results `fe` so far: [`kappe::run::evaluate_given`]
+/// The verdict of `cap` with the buckling results `fe` so far: [`kappe::run::evaluate`]
 /// with the design's own analysis options and no robot plan.
 fn evaluate(cap: &Cap, fe: &BTreeMap<usize, StateFe>) -> Result<kappe::Outcome, DesignError> {
     let options = kappe::Options {
@@ -344,7 +345,12 @@ fn evaluate(cap: &Cap, fe: &BTreeMap<usize, StateFe>) -> Result<kappe::Outcome, 
         robot: false,
         allow_fail: false,
     };
-    kappe::run::evaluate_given(cap.clone(), &options, fe.values().cloned().collect())
+    kappe::run::evaluate(
+        cap.clone(),
+        &options,
+        Some(fe.values().cloned().collect()),
+        &kappe::no_progress,
+    )
 }
 
 /// The report of an outcome for the page: per state the stresses, overhang and BLF, the
@@ -447,7 +453,8 @@ impl WorkerCore {
     ) -> Result<(), FieldError> {
         if self.cap.is_none() || self.text != text {
             let design = Design::from_toml_str(text).map_err(|e| FieldError::of(&e))?;
-            let cap = kappe::design_cap(&design, &|_| {}).map_err(|e| FieldError::of(&e))?;
+            let cap = kappe::design_cap(&design, kappe::Context::default())
+                .map_err(|e| FieldError::of(&e))?;
             let schedule = kappe::schedule::cap_schedule(&cap).map_err(|e| FieldError::of(&e))?;
             self.green = analysis_green(&cap, Some(&schedule)).map_err(|e| FieldError::of(&e))?;
             self.cap = Some(cap);

@@ -10,7 +10,11 @@ fn main() {
 /// Everything: layer form-finding, sections, all 113 states with their force passes, path, mesh.
 #[divan::bench(sample_count = 20)]
 fn default_design_all_states() -> kappe::Cap {
-    design_cap(divan::black_box(&Design::default()), &|_| {}).unwrap()
+    design_cap(
+        divan::black_box(&Design::default()),
+        kappe::Context::default(),
+    )
+    .unwrap()
 }
 
 /// Layer form-finding alone (constrained CEM inside the self-weight fixed point).

@@ -13,7 +13,7 @@ use kappe::analysis::{AnalysisOptions, analyze, state_buckling, state_material};
 fn profile(file: &str, states: &[usize]) -> Result<(), Box<dyn std::error::Error>> {
     let design = kappe::Design::from_toml_str(&std::fs::read_to_string(file)?)?;
     let t = Instant::now();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     println!(
         "{file}: {} states, design_cap {:.2} s",
         cap.states.len(),
@@ -89,14 +89,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or(AnalysisOptions::default().row_stride);
     let design = kappe::Design::default();
     let t0 = Instant::now();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let t_form = t0.elapsed().as_secs_f64();
     let options = AnalysisOptions {
         row_stride: stride,
         ..AnalysisOptions::default()
     };
     let t1 = Instant::now();
-    let analysis = analyze(&cap, &options, &|_| {})?;
+    let analysis = analyze(&cap, &options, kappe::analysis::Request::default())?;
     let t_analysis = t1.elapsed().as_secs_f64();
     println!(
         "default design, {} states, row stride {stride}",

@@ -27,8 +27,8 @@ fn run(name: &str, design: &kappe::Design) -> Result<(), Box<dyn std::error::Err
     ] {
         let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
         let t = Instant::now();
-        let cap = kappe::design_cap(design, &|_| {})?;
-        let a = analyze(&cap, &options, &|_| {})?;
+        let cap = kappe::design_cap(design, kappe::Context::default())?;
+        let a = analyze(&cap, &options, kappe::analysis::Request::default())?;
         let wall = t.elapsed().as_secs_f64();
         let cpu = measure::cpu_seconds().unwrap_or(0.0) - cpu0;
         let solved = a

@@ -96,7 +96,7 @@ fn states(
     picks: &[usize],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let d = design(length);
-    let cap = kappe::design_cap(&d, &|_| {})?;
+    let cap = kappe::design_cap(&d, kappe::Context::default())?;
     println!("cap length {length} m, {} states", cap.states.len());
     println!(
         "| state | splits: factor (DOFs, s) | order | reference | Kappe estimate | its error estimate | Kappe vs reference | mesh vs reference |"
@@ -137,10 +137,10 @@ fn states(
 
 fn table(length: f64, every: usize) -> Result<(), Box<dyn std::error::Error>> {
     let d = design(length);
-    let cap = kappe::design_cap(&d, &|_| {})?;
+    let cap = kappe::design_cap(&d, kappe::Context::default())?;
     let run = |o: &AnalysisOptions| -> Result<(kappe::analysis::Analysis, f64), String> {
         let t = Instant::now();
-        let a = analyze(&cap, o, &|_| {}).map_err(|e| e.to_string())?;
+        let a = analyze(&cap, o, kappe::analysis::Request::default()).map_err(|e| e.to_string())?;
         Ok((a, t.elapsed().as_secs_f64()))
     };
     let (sampled, t_sampled) = run(&AnalysisOptions::default())?;

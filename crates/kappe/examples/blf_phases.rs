@@ -32,7 +32,7 @@ fn row(top: usize, what: &str, r: &BucklingResult, wall: f64) {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let design = kappe::Design::default();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let options = AnalysisOptions::default();
     let mut states: Vec<usize> = std::env::args()
         .skip(1)

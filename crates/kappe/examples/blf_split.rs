@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(l) = std::env::var("LEN") {
         design.cap.length = l.parse()?;
     }
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let options = AnalysisOptions::default();
     let el = std::env::var("EL")
         .ok()

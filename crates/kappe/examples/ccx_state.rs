@@ -73,7 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(path) => kappe::Design::from_toml_str(&std::fs::read_to_string(path)?)?,
         None => kappe::Design::default(),
     };
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let options = AnalysisOptions::default();
     let dir = Path::new("target/ccx_state");
     std::fs::create_dir_all(dir)?;

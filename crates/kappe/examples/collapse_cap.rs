@@ -11,7 +11,7 @@ use kappe::input::nonlinear::NonlinearSpec;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let design = kappe::Design::from_toml_str(kappe::input::design::EXAMPLE_TOML)?;
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let off = AnalysisOptions {
         nonlinear: Some(NonlinearSpec {
             enabled: false,
@@ -20,7 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     let t0 = Instant::now();
-    let a = analyze(&cap, &off, &|_| {})?;
+    let a = analyze(&cap, &off, kappe::analysis::Request::default())?;
     let t_off = t0.elapsed().as_secs_f64();
     let mut by_bound: Vec<(usize, f64)> = a
         .states
@@ -58,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         nonlinear: Some(NonlinearSpec::default()),
         ..Default::default()
     };
-    let a2 = analyze(&cap, &on, &|_| {})?;
+    let a2 = analyze(&cap, &on, kappe::analysis::Request::default())?;
     let t_on = t1.elapsed().as_secs_f64();
     let run: Vec<String> = a2
         .states

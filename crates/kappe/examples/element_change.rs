@@ -15,7 +15,7 @@ use kappe_fe::{BucklingOptions, ElementKind};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let design = kappe::Design::default();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let mut options = AnalysisOptions::default();
     if let Some(s) = std::env::args().nth(1) {
         options.row_stride = s.parse()?;

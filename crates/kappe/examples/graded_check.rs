@@ -45,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .map(|s| s.parse())
         .transpose()?
         .unwrap_or_default();
-    let cap = design_cap(&d, &|_| {})?;
+    let cap = design_cap(&d, kappe::Context::default())?;
     let total = cap.states.len();
     let run = |grading: Option<Grading>| -> Result<(Vec<Option<f64>>, f64), String> {
         let o = AnalysisOptions {
@@ -53,7 +53,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             grading,
             ..AnalysisOptions::default()
         };
-        let a = analyze(&cap, &o, &|_| {}).map_err(|e| e.to_string())?;
+        let a =
+            analyze(&cap, &o, kappe::analysis::Request::default()).map_err(|e| e.to_string())?;
         Ok((a.states.iter().map(|s| s.blf).collect(), a.timings.fe))
     };
     let argmin = |v: &[Option<f64>]| {

@@ -13,9 +13,9 @@ use measure::{cpu_seconds, load_average};
 /// Wall-clock and CPU seconds of the analysis.
 fn run(toml: &str) -> Result<(f64, f64), Box<dyn std::error::Error>> {
     let design = kappe::Design::from_toml_str(toml)?;
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let (t0, c0) = (Instant::now(), cpu_seconds().unwrap_or(f64::NAN));
-    kappe::analysis::analyze(&cap, &design.analysis, &|_| {})?;
+    kappe::analysis::analyze(&cap, &design.analysis, kappe::analysis::Request::default())?;
     Ok((
         t0.elapsed().as_secs_f64(),
         cpu_seconds().unwrap_or(f64::NAN) - c0,

@@ -13,7 +13,7 @@ fn main() {
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "end_wall") {
         d.cap.end = kappe::form::ends::EndKind::EndWall;
     }
-    let cap = design_cap(&d, &|_| {}).expect("design");
+    let cap = design_cap(&d, kappe::Context::default()).expect("design");
     let total = cap.states.len();
     let top: usize = args
         .get(1)

@@ -10,7 +10,7 @@ mod measure;
 use measure::{cpu_seconds, load_average};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let cap = kappe::design_cap(&kappe::Design::default(), &|_| {})?;
+    let cap = kappe::design_cap(&kappe::Design::default(), kappe::Context::default())?;
     let (setup, options) = kappe::robot_plan::robot_inputs(&cap);
     let layers = kappe::robot_plan::print_layers(&cap.path);
     if let Some(out) = std::env::args().nth(1) {

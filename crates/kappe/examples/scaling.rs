@@ -46,10 +46,10 @@ fn one(length: f64) -> Result<(), Box<dyn std::error::Error>> {
     d.analysis.grading = Some(kappe::analysis::graded::Grading::default());
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
-    let cap = kappe::design_cap(&d, &|_| {})?;
+    let cap = kappe::design_cap(&d, kappe::Context::default())?;
     let t_design = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let a = kappe::analysis::analyze(&cap, &d.analysis, &|_| {})?;
+    let a = kappe::analysis::analyze(&cap, &d.analysis, kappe::analysis::Request::default())?;
     let t_analysis = t.elapsed().as_secs_f64();
     let cpu = measure::cpu_seconds().unwrap_or(0.0) - cpu0;
     let nodes = cap.states.last().map_or(0, |s| s.nodes);

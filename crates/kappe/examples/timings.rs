@@ -61,10 +61,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let design = kappe::Design::default();
     let t = Instant::now();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let t_design = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let analysis = kappe::analysis::analyze(&cap, &Default::default(), &|_| {})?;
+    let analysis = kappe::analysis::analyze(
+        &cap,
+        &Default::default(),
+        kappe::analysis::Request::default(),
+    )?;
     let t_analysis = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let plan = kappe::robot_plan::plan_robot(&cap)?;

@@ -31,5 +31,5 @@ pub mod schedule;
 pub mod verdict;
 
 pub use form::{Cap, StateSummary, design_cap};
-pub use input::{Design, DesignError};
+pub use input::{Context, Design, DesignError};
 pub use run::{Options, Outcome, Progress, Stage, evaluate, no_progress, run};

@@ -180,46 +180,34 @@ pub fn run(
 ) -> Result<Outcome, DesignError> {
     let stop = AtomicBool::new(false);
     let states = Ticker::new(on_progress, &stop, Stage::States);
-    let cap = crate::form::cap::design_cap_until(design, &|total| states.tick(total), &stop)?;
+    let cap = crate::form::cap::design_cap(
+        design,
+        crate::input::context::Context::new(&|total| states.tick(total), &stop),
+    )?;
     check(&stop)?;
-    evaluate_until(cap, options, on_progress, &stop, None)
+    after_form(cap, options, on_progress, &stop, None)
 }
 
-/// The pipeline after form-finding (see [`run`]): analysis, robot plan, verdict.
+/// The pipeline after form-finding (see [`run`]): analysis, robot plan, verdict. `fe`: the
+/// finite-element results of the analysed states computed elsewhere
+/// ([`crate::analysis::check::state_fe`] over [`crate::analysis::check::fe_runs`]: the
+/// designer's Web Workers), so the designer's verdict is the one `kappe design` reaches; states
+/// missing from it count as not analysed. Plan no robot then (`options.robot = false`) when
+/// `fe` was computed on the schedule without a plan ([`crate::schedule::cap_schedule`]).
+/// `None`: solve every analysed state here.
 ///
 /// # Errors
 /// As [`run`], without the form-finding ones.
 pub fn evaluate(
     cap: Cap,
     options: &Options,
+    fe: Option<Vec<crate::analysis::check::StateFe>>,
     on_progress: OnProgress<'_>,
 ) -> Result<Outcome, DesignError> {
-    evaluate_until(cap, options, on_progress, &AtomicBool::new(false), None)
+    after_form(cap, options, on_progress, &AtomicBool::new(false), fe)
 }
 
-/// [`evaluate`] with the finite-element results of the analysed states computed elsewhere
-/// ([`crate::analysis::check::state_fe`] over [`crate::analysis::check::fe_runs`]: the
-/// designer's Web Workers), so the designer's verdict is the one `kappe design` reaches. States
-/// missing from `fe` count as not analysed. Plan no robot here (`options.robot = false`) when
-/// `fe` was computed on the schedule without a plan ([`crate::schedule::cap_schedule`]).
-///
-/// # Errors
-/// As [`evaluate`].
-pub fn evaluate_given(
-    cap: Cap,
-    options: &Options,
-    fe: Vec<crate::analysis::check::StateFe>,
-) -> Result<Outcome, DesignError> {
-    evaluate_until(
-        cap,
-        options,
-        &no_progress,
-        &AtomicBool::new(false),
-        Some(fe),
-    )
-}
-
-fn evaluate_until(
+fn after_form(
     cap: Cap,
     options: &Options,
     on_progress: OnProgress<'_>,
@@ -262,21 +250,17 @@ fn evaluate_until(
     check(stop)?;
     let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
-    let analysis = match (&options.analysis, given) {
-        (Some(o), Some(given)) => Some(crate::analysis::check::analyze_given(
+    let analysis = match &options.analysis {
+        Some(o) => Some(crate::analysis::analyze(
             &cap,
             o,
-            Some(&schedule),
-            given,
+            crate::analysis::Request {
+                schedule: Some(&schedule),
+                fe: given,
+                context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
+            },
         )?),
-        (Some(o), None) => Some(crate::analysis::check::analyze_scheduled(
-            &cap,
-            o,
-            Some(&schedule),
-            &|total| fe.tick(total),
-            stop,
-        )?),
-        (None, _) => None,
+        None => None,
     };
     check(stop)?;
     // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.

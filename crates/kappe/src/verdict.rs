@@ -315,7 +315,7 @@ mod tests {
              [constraints]\noverhang_max = 0.05\n{constraints}"
         ))
         .unwrap();
-        crate::design_cap(&design, &|_| {}).unwrap()
+        crate::design_cap(&design, crate::Context::default()).unwrap()
     }
 
     #[test]
@@ -349,7 +349,8 @@ mod tests {
             buckling: false,
             ..Default::default()
         };
-        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let analysis =
+            crate::analysis::analyze(&cap, &options, crate::analysis::Request::default()).unwrap();
         let with = verdict(&cap, Some(&analysis), RobotResults::default());
         let without = verdict(&cap, None, RobotResults::default());
         assert_eq!(with.ok, without.ok);

@@ -42,7 +42,7 @@ pub(crate) fn optimize_design(
     // loop after the evaluation under way.
     let deliver = |cb: &Bound<'_, PyAny>, e: String| -> PyResult<()> { cb.call1((e,)).map(drop) };
     let result = run_with_progress(py, progress, deliver, |stop, tick| {
-        optimize::optimize_until(&file, &start, &|e| {
+        optimize::optimize(&file, &start, &|e| {
             tick(serde_json::to_string(e).unwrap_or_default());
             if stop.load(Ordering::Relaxed) {
                 ControlFlow::Break(())

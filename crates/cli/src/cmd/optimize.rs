@@ -72,6 +72,7 @@ pub fn run(args: OptimizeArgs) -> Result<ExitCode> {
         if !quiet {
             println!("{}", e.line());
         }
+        std::ops::ControlFlow::Continue(())
     })
     .context("the design loop failed")?;
 

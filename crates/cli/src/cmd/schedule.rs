@@ -50,7 +50,7 @@ pub fn run(args: ScheduleArgs) -> Result<ExitCode> {
         Some(out) => Some(prepare_dir(out, args.force, "kappe schedule")?),
         None => None,
     };
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let plan =
         kappe::commands::least_waits::least_waits(&cap, &design.analysis, args.wait_max, &|_| {})?;
     let json = serde_json::to_string_pretty(&kappe::commands::least_waits::document(

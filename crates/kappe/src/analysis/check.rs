@@ -16,6 +16,7 @@ use super::stress::{
 use crate::form::cap::Cap;
 use crate::form::states::build_state;
 use crate::input::analysis::AnalysisOptions;
+use crate::input::context::Context;
 use crate::input::error::DesignError;
 
 /// Consecutive states per warm-started run: each run's first state starts cold, so longer runs
@@ -292,7 +293,7 @@ pub type GreenChecks = (
 
 /// The finite-element part of one state's analysis ([`state_fe`]): what [`analyze`] computes per
 /// selected state in parallel, and what the designer in the browser computes in its Web
-/// Workers and hands to [`analyze_given`].
+/// Workers and hands to [`analyze`] in [`Request::fe`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct StateFe {
     /// State index (top print index).
@@ -551,19 +552,46 @@ pub fn solve_states(
         .collect()
 }
 
-/// [`analyze`] with the finite-element results of the selected states computed elsewhere
-/// ([`state_fe`] over [`fe_runs`], e.g. in the designer's Web Workers): the stresses, the
-/// overhangs, the constraint report and the verdict from them, exactly as [`analyze`] makes
-/// them. A selected state missing from `fe` counts as not analysed (the designer's partial
-/// verdict while its workers run).
+/// What [`analyze`] is asked beyond the cap and its options.
+#[derive(Default)]
+pub struct Request<'a> {
+    /// The layers' ages from this schedule (the run's, on the robot plan's clock, issue 11);
+    /// `None`: path length / print speed and the `[schedule]` waits.
+    pub schedule: Option<&'a crate::schedule::Schedule>,
+    /// The finite-element results of the selected states computed elsewhere ([`state_fe`] over
+    /// [`fe_runs`], e.g. in the designer's Web Workers): the stresses, the overhangs, the
+    /// constraint report and the verdict are made from them exactly as from the states
+    /// [`analyze`] solves itself. A selected state missing here counts as not analysed (the
+    /// designer's partial verdict while its workers run). `None`: solve every selected state.
+    pub fe: Option<Vec<StateFe>>,
+    /// Progress (one step per buckling analysis finished) and cancellation (checked before every
+    /// state's rebuild and buckling solve).
+    pub context: Context<'a>,
+}
+
+/// Analyse every state of `cap` (see the module docs) as `request` asks.
 ///
 /// # Errors
-/// Invalid options, a state that cannot be built.
-pub fn analyze_given(
+/// Invalid options, a state that cannot be built or solved, a `[schedule]` that does not fit
+/// the print, or [`DesignError::Cancelled`].
+pub fn analyze(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    request: Request<'_>,
+) -> Result<Analysis, DesignError> {
+    match request.fe {
+        Some(fe) => analyze_from_fe(cap, options, request.schedule, fe, request.context),
+        None => analyze_all(cap, options, request.schedule, request.context),
+    }
+}
+
+/// [`analyze`] with the finite-element results given ([`Request::fe`]).
+fn analyze_from_fe(
     cap: &Cap,
     options: &AnalysisOptions,
     schedule: Option<&crate::schedule::Schedule>,
     fe: Vec<StateFe>,
+    context: Context<'_>,
 ) -> Result<Analysis, DesignError> {
     options.validate()?;
     let green = analysis_green(cap, schedule)?;
@@ -592,40 +620,19 @@ pub fn analyze_given(
         &interpolated,
         (t_all, 0.0),
         complete,
-        &AtomicBool::new(false),
+        context.stop_flag(),
     )
 }
 
-/// Analyse every state of `cap` (see the module docs). `on_state(n)` is called once per
-/// buckling analysis finished (for a progress bar), with the number `n` of them.
-pub fn analyze(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    on_state: &(dyn Fn(usize) + Sync),
-) -> Result<Analysis, DesignError> {
-    analyze_until(cap, options, on_state, &AtomicBool::new(false))
-}
-
-/// [`analyze`] that gives up with [`DesignError::Cancelled`] once `stop` is set (checked before
-/// every state's rebuild and buckling solve).
-pub(crate) fn analyze_until(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    on_state: &(dyn Fn(usize) + Sync),
-    stop: &AtomicBool,
-) -> Result<Analysis, DesignError> {
-    analyze_scheduled(cap, options, None, on_state, stop)
-}
-
-/// [`analyze_until`] with the layers' ages from `schedule` (the timed robot plan's, issue 11;
-/// `None`: path length / print speed and the `[schedule]` waits).
-pub(crate) fn analyze_scheduled(
+/// [`analyze`] solving every selected state itself.
+fn analyze_all(
     cap: &Cap,
     options: &AnalysisOptions,
     schedule: Option<&crate::schedule::Schedule>,
-    on_state: &(dyn Fn(usize) + Sync),
-    stop: &AtomicBool,
+    context: Context<'_>,
 ) -> Result<Analysis, DesignError> {
+    let on_state = |n| context.step(n);
+    let stop = context.stop_flag();
     options.validate()?;
     let t_all = Instant::now();
     let cancelled = || {

@@ -47,5 +47,5 @@ pub use buckling::{
     BucklingStatus, NetworkMode, StateBuckling, shell_buckling, shell_buckling_mode,
     state_buckling, state_buckling_mode, state_material,
 };
-pub use check::{Analysis, ConstraintResult, StateAnalysis, Timings, analyze};
+pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
 pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};

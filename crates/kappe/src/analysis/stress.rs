@@ -337,7 +337,7 @@ mod tests {
             let mut d = crate::Design::default();
             d.cap.length = length;
             d.cap.end = EndKind::EndWall;
-            let cap = crate::design_cap(&d, &|_| {}).expect("cap");
+            let cap = crate::design_cap(&d, crate::Context::default()).expect("cap");
             let phi = d.print.start_arch_fraction;
             let n = cap.sections.layers.len();
             let last = build_state(&cap.sections, &cap.frame, phi, n - 1).expect("state");
@@ -369,7 +369,8 @@ mod tests {
             }
         }
         // A start section: the forces of its layers depend on the state, so no shortcut.
-        let cap = crate::design_cap(&crate::Design::default(), &|_| {}).expect("cap");
+        let cap =
+            crate::design_cap(&crate::Design::default(), crate::Context::default()).expect("cap");
         assert!(!depth_invariant(&cap.sections));
         assert!(extremes_by_depth(&cap.sections, &[]).is_none());
     }

@@ -200,7 +200,7 @@ pub fn calibrate(
         let p = &r.prototype;
         // The states to analyse: the selection, plus (for a failure) the collapsed state and
         // every state before it, which all stood.
-        let cap = design_cap(&r.design, &|_| {})?;
+        let cap = design_cap(&r.design, crate::Context::default())?;
         let total = cap.states.len();
         let (survived_upto, failure_state) = match (p.outcome, p.failed_at_layer) {
             (Outcome::Failed, Some(k)) => {

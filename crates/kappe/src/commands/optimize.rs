@@ -389,21 +389,10 @@ fn better(a: (f64, Option<f64>), b: (f64, Option<f64>)) -> bool {
     matches!((a.1, b.1), (Some(va), Some(vb)) if va < vb * (1.0 - 1e-9))
 }
 
-/// Run the design loop from `start` (see the module docs). `on_eval` sees every evaluation.
+/// Run the design loop from `start` (see the module docs). `on_eval` sees every evaluation;
+/// `ControlFlow::Break` after one ends the loop with [`DesignError::Cancelled`] (the Python
+/// package's Ctrl-C).
 pub fn optimize(
-    file: &OptimizeFile,
-    start: &Design,
-    on_eval: &dyn Fn(&Evaluation),
-) -> Result<OptimizeResult, DesignError> {
-    optimize_until(file, start, &|e| {
-        on_eval(e);
-        ControlFlow::Continue(())
-    })
-}
-
-/// [`optimize`] that `on_eval` can stop: `ControlFlow::Break` after an evaluation ends the loop
-/// with [`DesignError::Cancelled`] (the Python package's Ctrl-C).
-pub fn optimize_until(
     file: &OptimizeFile,
     start: &Design,
     on_eval: &dyn Fn(&Evaluation) -> ControlFlow<()>,

@@ -1,8 +1,6 @@
 //! The whole cap pipeline as one plain function: design → arch → sections → states → forces →
 //! path → mesh. States are independent and solved in parallel (rayon); their order is kept.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-
 use rayon::prelude::*;
 
 use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer, form_find_layer_with_segments};
@@ -13,6 +11,7 @@ use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
 use crate::form::section::{Sections, build_corrugated_sections, build_sections_with_end};
 use crate::form::states::{State, build_state};
+use crate::input::context::Context;
 use crate::input::design::Design;
 use crate::input::error::DesignError;
 
@@ -140,18 +139,13 @@ fn corrugated_arches(
 }
 
 /// Form-find the layer, build the sections and states, and solve the forces of every state.
-/// `on_state(total)` is called once per solved state (for a progress bar), with the state count.
-pub fn design_cap(design: &Design, on_state: &(dyn Fn(usize) + Sync)) -> Result<Cap, DesignError> {
-    design_cap_until(design, on_state, &AtomicBool::new(false))
-}
-
-/// [`design_cap`] that gives up with [`DesignError::Cancelled`] once `stop` is set (checked
-/// before every state).
-pub(crate) fn design_cap_until(
-    design: &Design,
-    on_state: &(dyn Fn(usize) + Sync),
-    stop: &AtomicBool,
-) -> Result<Cap, DesignError> {
+/// `context` hears once per solved state (for a progress bar), with the state count, and is
+/// checked for a stop before every state.
+///
+/// # Errors
+/// An invalid design, a layer without an equilibrium form, a state that cannot be solved, or
+/// [`DesignError::Cancelled`].
+pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignError> {
     design.validate()?;
     let tilt = design.tilt();
     let frame = LayerFrame::new(tilt);
@@ -207,12 +201,10 @@ pub(crate) fn design_cap_until(
     let area = areas(design, &arch, &centre_arches);
     let total = sections.layers.len();
     let solve = |top: usize| {
-        if stop.load(Ordering::Relaxed) {
-            return Err(DesignError::Cancelled);
-        }
+        context.check()?;
         let state = build_state(&sections, &frame, phi, top)?;
         let (topology, pass, forces) = state_forces(&state, area)?;
-        on_state(total);
+        context.step(total);
         let summary = StateSummary {
             index: state.index,
             progress: state.progress,

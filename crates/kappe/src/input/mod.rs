@@ -5,6 +5,7 @@
 
 pub mod ageing;
 pub mod analysis;
+pub mod context;
 pub mod design;
 pub mod error;
 pub mod material;
@@ -13,5 +14,6 @@ pub mod resolve;
 pub mod schedule;
 pub mod uncertainty;
 
+pub use context::Context;
 pub use design::Design;
 pub use error::DesignError;

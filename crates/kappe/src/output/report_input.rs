@@ -1036,7 +1036,7 @@ mod tests {
         let design =
             crate::Design::from_toml_str("[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n")
                 .unwrap();
-        crate::design_cap(&design, &|_| {}).unwrap()
+        crate::design_cap(&design, crate::Context::default()).unwrap()
     }
 
     #[test]
@@ -1099,7 +1099,8 @@ mod tests {
             buckling: false,
             ..Default::default()
         };
-        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let analysis =
+            crate::analysis::analyze(&cap, &options, crate::analysis::Request::default()).unwrap();
         let extras = extras_from_analysis(&analysis);
         assert_eq!(extras.states.len(), cap.states.len());
         let input = report_input(&cap, &extras);
@@ -1140,7 +1141,8 @@ mod tests {
     fn modes_places_and_timeline_follow_the_analysis() {
         let cap = cheap_cap();
         let options = crate::analysis::AnalysisOptions::default();
-        let analysis = crate::analysis::analyze(&cap, &options, &|_| {}).unwrap();
+        let analysis =
+            crate::analysis::analyze(&cap, &options, crate::analysis::Request::default()).unwrap();
         let extras = extras_from_analysis(&analysis);
         let input = report_input(&cap, &extras);
         input.validate().unwrap();

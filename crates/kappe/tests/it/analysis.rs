@@ -34,7 +34,7 @@ fn final_coarse() -> AnalysisOptions {
 }
 
 fn cap(d: &Design) -> Cap {
-    design_cap(d, &|_| {}).unwrap()
+    design_cap(d, kappe::Context::default()).unwrap()
 }
 
 fn constraint<'a>(
@@ -48,7 +48,7 @@ fn constraint<'a>(
 fn default_design_passes_every_constraint_and_says_so() {
     let c = cap(&Design::default());
     // BLF 3.67 against BLF_min = 1 (bench): far from the limit, so the coarse mesh suffices.
-    let a = analyze(&c, &final_coarse(), &|_| {}).unwrap();
+    let a = analyze(&c, &final_coarse(), kappe::analysis::Request::default()).unwrap();
     assert!(a.ok, "{}", a.report());
     // σ_min, σ_max, BLF_min, l_o,max and the as-printed deviation_max (docs/as-printed.md).
     assert_eq!(a.constraints.len(), 5);
@@ -79,7 +79,12 @@ fn span_1_4_rise_0_12_fails_on_stress() {
     d.cap.span = 1.4;
     d.cap.rise = 0.12;
     d.print.path_sampling = 0.04;
-    let a = analyze(&cap(&d), &final_coarse(), &|_| {}).unwrap();
+    let a = analyze(
+        &cap(&d),
+        &final_coarse(),
+        kappe::analysis::Request::default(),
+    )
+    .unwrap();
     assert!(!a.ok);
     let s = constraint(&a, "sigma_min");
     assert!(!s.pass, "{}", a.report());
@@ -92,7 +97,12 @@ fn span_1_4_rise_0_12_fails_on_stress() {
 fn e_1_mpa_fails_on_buckling() {
     let mut d = Design::default();
     d.material.youngs_modulus = 1.0e6;
-    let a = analyze(&cap(&d), &final_coarse(), &|_| {}).unwrap();
+    let a = analyze(
+        &cap(&d),
+        &final_coarse(),
+        kappe::analysis::Request::default(),
+    )
+    .unwrap();
     assert!(!a.ok);
     let b = constraint(&a, "blf_min");
     assert!(!b.pass, "{}", a.report());
@@ -110,7 +120,7 @@ fn overhang_max_2_mm_fails_on_overhang() {
         buckling: false,
         ..AnalysisOptions::default()
     };
-    let a = analyze(&cap(&d), &opts, &|_| {}).unwrap();
+    let a = analyze(&cap(&d), &opts, kappe::analysis::Request::default()).unwrap();
     let o = constraint(&a, "overhang_max");
     assert!(!o.pass && !a.ok, "{}", a.report());
     // Centre layers overhang by lh·tan(am) = 3.73 mm (method.md §3), start layers up to 4.5 mm.
@@ -201,7 +211,9 @@ fn bad_options_are_named() {
         modes: 0,
         ..AnalysisOptions::default()
     };
-    let e = analyze(&c, &o, &|_| {}).unwrap_err().to_string();
+    let e = analyze(&c, &o, kappe::analysis::Request::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("analysis.modes"), "{e}");
     let o = AnalysisOptions {
         ageing: Some(Ageing {
@@ -211,7 +223,9 @@ fn bad_options_are_named() {
         }),
         ..AnalysisOptions::default()
     };
-    let e = analyze(&c, &o, &|_| {}).unwrap_err().to_string();
+    let e = analyze(&c, &o, kappe::analysis::Request::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("initial_modulus"), "{e}");
 }
 

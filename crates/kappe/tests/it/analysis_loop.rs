@@ -82,7 +82,10 @@ fn calibration_from_two_prototypes() {
     let stiff = small();
     let mut soft = small();
     soft.material.youngs_modulus = 1e6;
-    let total = kappe::design_cap(&soft, &|_| {}).unwrap().states.len();
+    let total = kappe::design_cap(&soft, kappe::Context::default())
+        .unwrap()
+        .states
+        .len();
     let file = format!(
         "[analysis]\nstates = \"every:100000\"\nrow_stride = 4\n\
          [[prototype]]\nname = \"stiff\"\ndesign = \"stiff.toml\"\noutcome = \"stood\"\n\
@@ -168,7 +171,7 @@ fn loop_finds_the_least_material_within_bounds() {
     // tested with `kappe optimize` in the CLI tests.
     let mut d = small();
     d.robot.enabled = false;
-    let r = optimize(&f, &d, &|_| {}).unwrap();
+    let r = optimize(&f, &d, &|_| std::ops::ControlFlow::Continue(())).unwrap();
     assert!(r.feasible, "{:?}", r.binding);
     let lw = r.parameters["print.layer_width"];
     assert!(
@@ -208,7 +211,7 @@ fn infeasible_request_names_the_binding_constraint() {
                 [analysis]\nbuckling = false\n[verify]\nbuckling = false\n\
                 [free]\n\"cap.tilt_deg\" = { min = 20.0, max = 30.0 }\n";
     let f = OptimizeFile::from_toml_str(text).unwrap();
-    let r = optimize(&f, &d, &|_| {}).unwrap();
+    let r = optimize(&f, &d, &|_| std::ops::ControlFlow::Continue(())).unwrap();
     assert!(!r.feasible);
     assert!(
         r.binding.iter().any(|b| b == "overhang_max"),

@@ -14,7 +14,7 @@ fn small() -> Design {
 }
 
 fn final_blf(d: &Design) -> f64 {
-    let cap = kappe::design_cap(d, &|_| {}).unwrap();
+    let cap = kappe::design_cap(d, kappe::Context::default()).unwrap();
     let last = cap.states.len() - 1;
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, last).unwrap();
     let o = AnalysisOptions {

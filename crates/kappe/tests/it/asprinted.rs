@@ -179,12 +179,13 @@ fn an_infinitely_stiffening_material_freezes_the_earlier_layers() {
 fn the_cap_as_printed_pass_reports_every_state() {
     // A short cap keeps the test quick (every state is solved: the deviation accumulates).
     let design = kappe::Design::from_toml_str("[cap]\nlength = 0.2\n").expect("design");
-    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
     // The buckling check of the final state only: the as-printed pass runs every state anyway.
     let mut options = design.analysis.clone();
     options.states = "every:1000".parse().expect("selection");
     options.converged_blf = false;
-    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
     let p = a.as_printed.as_ref().expect("as-printed pass");
     assert_eq!(p.states.len(), cap.states.len());
     // Equilibrium of every increment (Σ R = −Σ f): 1e-9 relative, the sparse solve's
@@ -217,7 +218,7 @@ fn the_cap_as_printed_pass_reports_every_state() {
         4.0 * design.material.youngs_modulus
     ))
     .expect("design");
-    let cap4 = kappe::design_cap(&stiff, &|_| {}).expect("cap");
+    let cap4 = kappe::design_cap(&stiff, kappe::Context::default()).expect("cap");
     let p4 = kappe::analysis::asprinted::cap_as_printed(&cap4, &options, None, &|| Ok(()))
         .expect("as-printed");
     // Same geometry, K scaled by 4: the deviation scales by 1/4 to round-off (1e-9).
@@ -236,11 +237,12 @@ fn a_deviation_above_deviation_max_fails_the_design_with_its_levers() {
         kappe::Design::from_toml_str("[cap]\nlength = 0.2\n[constraints]\ndeviation_max = 1e-6\n")
             .expect("design");
     assert_eq!(design.deviation_max(), 1e-6);
-    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
     let mut options = design.analysis.clone();
     options.states = "every:1000".parse().expect("selection");
     options.converged_blf = false;
-    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
     assert!(!a.ok);
     let row = a
         .constraints

@@ -8,7 +8,7 @@ use kappe_fe::BucklingOptions;
 
 /// Factors of a state of `d` on its print-layer mesh split 1, 2 and 4 times per edge.
 fn splits(d: &kappe::Design, top: usize) -> [f64; 3] {
-    let cap = kappe::design_cap(d, &|_| {}).unwrap();
+    let cap = kappe::design_cap(d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions::default();
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();
     let shell = state_shell(&state, &state_material(&cap, &o, top).unwrap(), 1).unwrap();
@@ -67,15 +67,20 @@ fn the_converged_factor_of_an_early_state_is_within_the_tolerance() {
 #[test]
 fn sampled_states_match_every_state_solved() {
     let d = kappe::Design::from_toml_str("[cap]\nlength = 0.3\n").unwrap();
-    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
-    let sampled = analyze(&cap, &AnalysisOptions::default(), &|_| {}).unwrap();
+    let cap = kappe::design_cap(&d, kappe::Context::default()).unwrap();
+    let sampled = analyze(
+        &cap,
+        &AnalysisOptions::default(),
+        kappe::analysis::Request::default(),
+    )
+    .unwrap();
     let all = analyze(
         &cap,
         &AnalysisOptions {
             blf_sampling: false,
             ..Default::default()
         },
-        &|_| {},
+        kappe::analysis::Request::default(),
     )
     .unwrap();
     let tol = AnalysisOptions::default().blf_tolerance;
@@ -111,7 +116,7 @@ fn sampled_states_match_every_state_solved() {
 fn the_split_pass_continues_from_the_first_pass() {
     use kappe::analysis::buckling::{state_buckling_mode, state_buckling_warm, state_refine};
     let d = kappe::Design::default();
-    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
+    let cap = kappe::design_cap(&d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions::default();
     let top = 40;
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();

@@ -71,7 +71,7 @@ fn network_residual(cap: &Cap) -> (f64, f64) {
 }
 
 fn check_invariants(d: &Design) {
-    let cap = design_cap(d, &|_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let cap = design_cap(d, kappe::Context::default()).unwrap_or_else(|e| panic!("{e}"));
     let frame = &cap.frame;
     let lh = d.print.layer_height;
     let span = d.cap.span;
@@ -249,7 +249,7 @@ fn default_design_keeps_every_invariant() {
 #[test]
 fn default_design_matches_the_method_numbers() {
     let d = Design::default();
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     // method.md §5–6 and §9 give these for the defaults (3 significant digits there).
     assert_eq!(cap.sections.n_centre, 68);
     assert_eq!(cap.sections.n_start, 45);
@@ -367,7 +367,7 @@ fn the_example_file_is_the_default_design() {
 fn meshes_are_valid_gltf_and_obj() {
     let mut d = Design::default();
     d.cap.length = 0.05;
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let glb = cap.mesh.to_glb().unwrap();
     let gltf = gltf::Gltf::from_slice(&glb).expect("valid GLB");
     let mesh = gltf.meshes().next().unwrap();

@@ -21,7 +21,7 @@ const WAVE: &str = "[cap.corrugation]\namplitude = 0.03\nwavelength = 0.15\n";
 #[test]
 fn every_corrugated_layer_is_a_compression_arch_in_equilibrium_in_its_plane() {
     let d = small(WAVE);
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let n_centre = cap.sections.n_centre;
     assert_eq!(cap.centre_arches.len(), n_centre);
     let frame = cap.frame;
@@ -124,7 +124,7 @@ fn the_measured_overhang_is_the_closed_form_one() {
     // offsets take the nearest segment of the layer below, whose tangent turns by at most
     // s/a_cat ≈ 0.05 rad near the crown: 1 % covers 1 − cos of that with room.
     let d = small("");
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let lh_tan = d.print.layer_height * cap.frame.tilt.tan();
     let measured = measured_overhangs(&cap.sections, &cap.frame);
     let formula = layer_overhangs(&cap.sections, &cap.frame);
@@ -141,7 +141,7 @@ fn the_measured_overhang_is_the_closed_form_one() {
     // the step, so l_o(crown) = lh·tan(am) − ΔCr/cos(am); the layer's largest |l_o| is at least
     // that (the crown is one of the nodes measured), within the same 1 %.
     let d = small(WAVE);
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let cos = cap.frame.tilt.cos();
     let mut beyond_smooth = false;
     for k in 1..cap.sections.n_centre {
@@ -193,7 +193,7 @@ fn an_overhang_beyond_the_limit_fails_naming_the_layer() {
         "[cap]\nlength = 0.2\n[print]\nlayer_height = 0.015\n{WAVE}"
     ))
     .unwrap();
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let rows = kappe::verdict::preliminary_constraints(&cap);
     let o = rows.iter().find(|r| r.name == "overhang_max").unwrap();
     assert!(!o.pass);

@@ -249,11 +249,11 @@ fn end_wall_is_a_robot_obstacle() {
     use kappe_robot::collision::Obstacle;
     let mut d = Design::default();
     d.cap.length = 0.2;
-    let start = kappe::design_cap(&d, &|_| {}).unwrap();
+    let start = kappe::design_cap(&d, kappe::Context::default()).unwrap();
     let (setup, _) = kappe::robot_plan::robot_inputs(&start);
     assert!(setup.obstacles.iter().all(|o| o.name() != "end_wall"));
     d.cap.end = EndKind::EndWall;
-    let cap = kappe::design_cap(&d, &|_| {}).unwrap();
+    let cap = kappe::design_cap(&d, kappe::Context::default()).unwrap();
     let (setup, _) = kappe::robot_plan::robot_inputs(&cap);
     let walls: Vec<_> = setup
         .obstacles

@@ -21,7 +21,8 @@ const FLOORS: [&str; 10] = [
 ];
 
 /// The root re-exports of `lib.rs` and the module each comes from.
-const ROOT_ITEMS: [(&str, &str); 11] = [
+const ROOT_ITEMS: [(&str, &str); 12] = [
+    ("Context", "input"),
     ("Design", "input"),
     ("DesignError", "input"),
     ("Cap", "form"),

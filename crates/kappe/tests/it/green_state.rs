@@ -353,10 +353,11 @@ type Fingerprint = (Vec<(Option<f64>, f64, f64)>, String);
 
 fn analysis_fingerprint(design_toml: &str) -> Fingerprint {
     let design = kappe::Design::from_toml_str(design_toml).expect("design");
-    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
     let mut options = design.analysis.clone();
     options.states = "every:10".parse().expect("selection");
-    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
     let states = a
         .states
         .iter()
@@ -413,10 +414,11 @@ fn cap_reports_strength_and_sliding_with_ages() {
         "[cap]\nlength = 0.2\n[material.time]\npreset = \"earth\"\nyoungs_modulus = 10.0e6\n",
     )
     .expect("design");
-    let cap = kappe::design_cap(&design, &|_| {}).expect("cap");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
     let mut options = design.analysis.clone();
     options.states = "every:10".parse().expect("selection");
-    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
     let strength = a
         .constraints
         .iter()
@@ -446,11 +448,12 @@ fn green_rows(
     design: &kappe::Design,
     grading: Option<kappe::analysis::graded::Grading>,
 ) -> Vec<GreenRow> {
-    let cap = kappe::design_cap(design, &|_| {}).expect("cap");
+    let cap = kappe::design_cap(design, kappe::Context::default()).expect("cap");
     let mut options = design.analysis.clone();
     options.states = "every:4".parse().expect("selection");
     options.grading = grading;
-    let a = kappe::analysis::analyze(&cap, &options, &|_| {}).expect("analysis");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
     a.states
         .iter()
         .filter(|s| s.blf.is_some())

@@ -70,7 +70,7 @@ fn bad_uncertainty_is_a_named_error() {
 #[test]
 fn buckling_scaling_matches_a_resolve() {
     let d = small();
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let o = d.analysis.clone();
     let last = cap.states.len() - 1;
     let state = build_state(&cap.sections, &cap.frame, 0.0, last).unwrap();
@@ -118,7 +118,7 @@ fn buckling_scaling_matches_a_resolve() {
 #[test]
 fn form_agrees_with_monte_carlo() {
     let d = small();
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let table = with_uncertainty(
         "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.35 }\n\
          \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n",
@@ -294,7 +294,7 @@ fn blf_sensitivity_of_a_cap_state_matches_finite_differences() {
         youngs_modulus_rate: Some(2.0e4),
         ..Default::default()
     });
-    let cap = design_cap(&d, &|_| {}).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
     let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
     let last = cap.states.len() - 1;
     let time = d.time_model().unwrap();
@@ -374,7 +374,7 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
     // Nominal values: every state passes without a wait.
     let mut nominal = study14(None);
     nominal.uncertainty = None;
-    let cap = design_cap(&nominal, &|_| {}).unwrap();
+    let cap = design_cap(&nominal, kappe::Context::default()).unwrap();
     let plan = least_waits(&cap, &nominal.analysis, 0.0, &|_| {}).unwrap();
     assert!(
         plan.infeasible.is_empty() && plan.states.iter().all(|c| c.pass),
@@ -384,7 +384,7 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
     // The last states govern (the cap's BLF falls towards its completion, BLF₀ of the last
     // state 1.39); the earlier ones have β > 4 either way.
     let last_betas = |d: &Design| -> Vec<f64> {
-        let cap = design_cap(d, &|_| {}).unwrap();
+        let cap = design_cap(d, kappe::Context::default()).unwrap();
         let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
         let n = cap.states.len();
         (n - 4..n)
@@ -406,7 +406,7 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
     let low = dried.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(low < beta_min, "drying mix: β {dried:?} all ≥ {beta_min}");
     // The least waits with the same drift.
-    let cap = design_cap(&drying, &|_| {}).unwrap();
+    let cap = design_cap(&drying, kappe::Context::default()).unwrap();
     let plan = least_waits(&cap, &drying.analysis, 600.0, &|_| {}).unwrap();
     assert!(plan.infeasible.is_empty(), "{:?}", plan.infeasible);
     assert!(plan.schedule.total_wait_s() > 0.0, "no wait was needed");

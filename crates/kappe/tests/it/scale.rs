@@ -14,14 +14,14 @@ use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
 use kappe::{Design, design_cap};
 
 fn blfs(d: &Design, every: usize, grading: Option<Grading>) -> Vec<Option<f64>> {
-    let cap = design_cap(d, &|_| {}).unwrap();
+    let cap = design_cap(d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions {
         modes: 1,
         states: StateSelection::Every(every),
         grading,
         ..AnalysisOptions::default()
     };
-    analyze(&cap, &o, &|_| {})
+    analyze(&cap, &o, kappe::analysis::Request::default())
         .unwrap()
         .states
         .iter()

@@ -28,7 +28,7 @@ fn element_option_parses() {
 #[test]
 fn final_state_blf_drops_by_the_shear_share() {
     let design = kappe::Design::default();
-    let cap = kappe::design_cap(&design, &|_| {}).unwrap();
+    let cap = kappe::design_cap(&design, kappe::Context::default()).unwrap();
     let last = cap.states.len() - 1;
     let state = build_state(
         &cap.sections,
