@@ -425,7 +425,7 @@ pub struct Equilibrium {
     pub iterations: Iterations,
     /// Global checks.
     pub checks: Checks,
-    index: crate::model::IdIndex,
+    index: crate::topology::IdIndex,
     dev_adj: Vec<Vec<usize>>,
     trail_adj: Vec<Vec<usize>>,
 }

@@ -4,7 +4,7 @@
 //! and what would be allowed. compas_cem reports most of these as bare `AssertionError`s or
 //! not at all (cem.md §2); Kappe rejects them up front so that no partial result is produced.
 
-use crate::topology::NodeId;
+use crate::ids::NodeId;
 
 /// Everything that can go wrong when reading, validating, solving or optimizing a topology.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -200,7 +200,7 @@ pub fn read_topology(text: &str) -> Result<TopologyFile, CemError> {
             })
             .collect(),
     };
-    crate::model::check_elements(&topology)?;
+    crate::topology::check_elements(&topology)?;
     Ok(TopologyFile {
         topology,
         description: raw.description,

@@ -43,6 +43,7 @@ pub mod equilibrium;
 pub mod error;
 pub mod example;
 pub mod fixed_geometry;
+mod ids;
 pub mod json;
 pub mod model;
 pub mod optimize;

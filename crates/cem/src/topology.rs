@@ -10,12 +10,13 @@
 //! Sign conventions: trail length `λ < 0` and deviation force `μ < 0` mean compression,
 //! positive means tension.
 
+use std::collections::HashMap;
+
 use nalgebra::Vector3;
 
 use crate::error::CemError;
 
-/// A node id: any non-negative integer, unique within a topology.
-pub type NodeId = u64;
+pub use crate::ids::NodeId;
 
 /// A node of the topology diagram.
 #[derive(Debug, Clone, PartialEq)]
@@ -257,7 +258,160 @@ impl TopologyBuilder {
         if let Some(e) = self.pending_error {
             return Err(e);
         }
-        crate::model::check_elements(&self.topo)?;
+        check_elements(&self.topo)?;
         Ok(self.topo)
     }
+}
+
+/// Node id → model index. Ids are usually dense small integers, so ids below a cap
+/// (4·n + 1024) live in a plain table and only the rest in a hash map: the lookups of
+/// trail building dominated a 500-node solve with a hash map alone.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct IdIndex {
+    dense: Vec<usize>,
+    sparse: HashMap<NodeId, usize>,
+}
+
+impl IdIndex {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            dense: vec![usize::MAX; 4 * n + 1024],
+            sparse: HashMap::new(),
+        }
+    }
+
+    pub(crate) fn get(&self, id: &NodeId) -> Option<&usize> {
+        match usize::try_from(*id).ok().and_then(|k| self.dense.get(k)) {
+            Some(i) if *i != usize::MAX => Some(i),
+            Some(_) => None,
+            None => self.sparse.get(id),
+        }
+    }
+
+    pub(crate) fn contains_key(&self, id: &NodeId) -> bool {
+        self.get(id).is_some()
+    }
+
+    /// Insert; returns the previous index if the id was present.
+    pub(crate) fn insert(&mut self, id: NodeId, i: usize) -> Option<usize> {
+        match usize::try_from(id).ok().and_then(|k| self.dense.get_mut(k)) {
+            Some(slot) => {
+                let old = *slot;
+                *slot = i;
+                (old != usize::MAX).then_some(old)
+            }
+            None => self.sparse.insert(id, i),
+        }
+    }
+}
+
+fn finite(what: impl FnOnce() -> String, value: f64) -> Result<(), CemError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(CemError::NonFinite {
+            what: what(),
+            value,
+        })
+    }
+}
+
+fn finite3(what: impl Fn() -> String, v: &Vector3<f64>) -> Result<(), CemError> {
+    for (i, c) in v.iter().enumerate() {
+        finite(|| format!("{}[{i}]", what()), *c)?;
+    }
+    Ok(())
+}
+
+/// Element-level checks shared by [`crate::TopologyBuilder::build`] and [`Model::new`].
+pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
+    let mut index = IdIndex::with_capacity(topo.nodes.len());
+    for (i, n) in topo.nodes.iter().enumerate() {
+        if index.insert(n.id, i).is_some() {
+            return Err(CemError::DuplicateNode { id: n.id });
+        }
+        finite3(|| format!("node {} xyz", n.id), &n.xyz)?;
+        finite3(|| format!("node {} load", n.id), &n.load)?;
+    }
+    // Duplicate pairs are found by sorting after the loop; descriptions are only formatted
+    // on error (this check runs on every solve).
+    let mut pairs: Vec<((NodeId, NodeId), usize)> =
+        Vec::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
+    let check_pair = |pairs: &mut Vec<((NodeId, NodeId), usize)>,
+                      kind: &'static str,
+                      u: NodeId,
+                      v: NodeId|
+     -> Result<(), CemError> {
+        for id in [u, v] {
+            if !index.contains_key(&id) {
+                return Err(CemError::UnknownNode {
+                    id,
+                    context: format!("{kind} edge ({u}, {v})"),
+                });
+            }
+        }
+        if u == v {
+            return Err(CemError::SelfLoop { kind, u });
+        }
+        let k = pairs.len();
+        pairs.push(((u.min(v), u.max(v)), k));
+        Ok(())
+    };
+    for e in &topo.trail_edges {
+        check_pair(&mut pairs, "trail", e.u, e.v)?;
+        finite(|| format!("trail edge ({}, {}) length", e.u, e.v), e.length)?;
+        if let Some(p) = &e.plane {
+            finite3(
+                || format!("trail edge ({}, {}) plane origin", e.u, e.v),
+                &p.origin,
+            )?;
+            finite3(
+                || format!("trail edge ({}, {}) plane normal", e.u, e.v),
+                &p.normal,
+            )?;
+            if p.normal.norm() == 0.0 {
+                return Err(CemError::ZeroPlaneNormal { u: e.u, v: e.v });
+            }
+        }
+    }
+    for e in &topo.deviation_edges {
+        check_pair(&mut pairs, "deviation", e.u, e.v)?;
+        finite(
+            || format!("deviation edge ({}, {}) force", e.u, e.v),
+            e.force,
+        )?;
+    }
+    pairs.sort_unstable();
+    if let Some(w) = pairs.windows(2).find(|w| w[0].0 == w[1].0) {
+        let n_trail = topo.trail_edges.len();
+        let describe = |k: usize| match k.checked_sub(n_trail) {
+            None => topo
+                .trail_edges
+                .get(k)
+                .map_or_else(String::new, |e| format!("trail edge ({}, {})", e.u, e.v)),
+            Some(d) => topo.deviation_edges.get(d).map_or_else(String::new, |e| {
+                format!("deviation edge ({}, {})", e.u, e.v)
+            }),
+        };
+        let ((u, v), _) = w[1];
+        return Err(CemError::DuplicateEdge {
+            u,
+            v,
+            first: describe(w[0].1),
+            second: describe(w[1].1),
+        });
+    }
+    if let Some(aux) = &topo.auxiliary_trails {
+        finite(|| "auxiliary_trails.length".to_string(), aux.length)?;
+        finite3(|| "auxiliary_trails.vector".to_string(), &aux.vector)?;
+    }
+    for s in &topo.trail_shifts {
+        if !index.contains_key(&s.origin) {
+            return Err(CemError::UnknownNode {
+                id: s.origin,
+                context: "trail shift".to_string(),
+            });
+        }
+    }
+    Ok(index)
 }

@@ -149,16 +149,6 @@ impl ElementKind {
             Self::CstDkmt => "CST + drilling + DKMT Reissner-Mindlin plate, shear factor 5/6",
         }
     }
-
-    /// The element implementation.
-    pub fn implementation(self) -> Box<dyn crate::element::ShellElement> {
-        match self {
-            Self::CstDkt => Box::new(crate::element::cst_dkt::CstDkt),
-            Self::AndesDkt => Box::new(crate::element::andes_dkt::AndesDkt),
-            Self::AndesDkmt => Box::new(crate::element::dkmt::AndesDkmt),
-            Self::CstDkmt => Box::new(crate::element::dkmt::CstDkmt),
-        }
-    }
 }
 
 /// Longest edge / smallest height above which a triangle is rejected as degenerate. Grid

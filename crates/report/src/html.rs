@@ -14,6 +14,7 @@ use std::fmt::Write as _;
 
 use crate::error::ReportError;
 use crate::input::ReportInput;
+use crate::markup::{escape_html, strip_xml_declaration};
 use crate::plots::{PlotSpec, fmt_num, render_plot, standard_plots};
 
 /// The vendored three.js bundle (three 0.187.0 + OrbitControls, MIT; see `assets/three-LICENSE.txt`).
@@ -24,23 +25,6 @@ pub const THREE_LICENSE: &str = include_str!("../assets/three-LICENSE.txt");
 pub const VIEWER_JS: &str = include_str!("../assets/viewer.js");
 /// The page's style sheet.
 pub const REPORT_CSS: &str = include_str!("../assets/report.css");
-
-/// Escapes text for HTML element content and double-quoted attribute values.
-#[must_use]
-pub fn escape_html(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            _ => out.push(c),
-        }
-    }
-    out
-}
 
 /// Makes JavaScript safe to inline in a classic `<script>` element: the HTML parser ends the
 /// element at the first `</script` (any case), so every `</` becomes `<\/`, which JavaScript
@@ -338,17 +322,6 @@ pub fn render_html(input: &ReportInput) -> Result<String, ReportError> {
         viewer = escape_inline_script(VIEWER_JS),
     );
     Ok(h)
-}
-
-/// Inline SVG in HTML must not carry an XML declaration.
-pub(crate) fn strip_xml_declaration(svg: &str) -> &str {
-    let s = svg.trim_start();
-    if s.starts_with("<?xml")
-        && let Some(end) = s.find("?>")
-    {
-        return s.get(end + 2..).unwrap_or(s).trim_start();
-    }
-    s
 }
 
 #[cfg(test)]

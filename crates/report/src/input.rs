@@ -16,6 +16,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::error::ReportError;
+pub use crate::series::{Plot, Series};
 
 /// A point or vector in world coordinates (m for points).
 pub type Vec3 = [f64; 3];
@@ -65,7 +66,7 @@ pub struct ReportInput {
     /// The print schedule (layer start/end/wait), which check governs each analysed state and
     /// the layer ages at the governing state(s) (issue 11).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub schedule: Option<crate::schedule::PrintSchedule>,
+    pub schedule: Option<PrintSchedule>,
     /// The robot plan's slowdowns and clearances (capsules and meshes, at the waypoints and
     /// certified along the motion; issue 13).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -345,26 +346,66 @@ pub struct RobotAnimation {
     pub base: Vec<[f64; 3]>,
 }
 
-/// A line plot rendered as inline SVG.
+// The print schedule's data (its rendering is `crate::schedule`).
+
+/// The print schedule and what governs each state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-pub struct Plot {
-    /// Title above the plot.
-    pub title: String,
-    /// x axis label (with unit).
-    pub x_label: String,
-    /// y axis label (with unit).
-    pub y_label: String,
-    /// The curves.
-    pub series: Vec<Series>,
+pub struct PrintSchedule {
+    /// Where the times come from, in words (e.g. `robot plan`, `path length / print speed`).
+    pub source: String,
+    /// One row per layer, in print order.
+    pub layers: Vec<ScheduleRow>,
+    /// Per analysed state, the utilisation of each check.
+    pub states: Vec<StateGoverning>,
+    /// The age of every printed layer at the governing state(s).
+    pub ages: Vec<StateAges>,
 }
 
-/// One curve of a [`Plot`].
+/// One layer of the schedule.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Series {
-    /// Legend name.
-    pub name: String,
-    /// Points (x, y) in drawing order.
-    pub points: Vec<[f64; 2]>,
+pub struct ScheduleRow {
+    /// Layer id.
+    pub layer: i32,
+    /// Start of printing, s.
+    pub start: f64,
+    /// End of printing, s.
+    pub end: f64,
+    /// Chosen wait after the layer, s.
+    pub wait: f64,
+    /// Other pause after it (station change, program change), s.
+    pub pause: f64,
+}
+
+/// The checks of one state: each check's utilisation (demand / capacity; > 1 fails).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StateGoverning {
+    /// State index (as in [`crate::PrintState::index`]).
+    pub state: usize,
+    /// `(check, utilisation)` for every check made in this state: `buckling`, `strength`,
+    /// `sliding`, `stress`, `overhang`.
+    pub checks: Vec<(String, f64)>,
+}
+
+impl StateGoverning {
+    /// The check with the largest utilisation.
+    #[must_use]
+    pub fn governing(&self) -> Option<(&str, f64)> {
+        self.checks
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(c, u)| (c.as_str(), *u))
+    }
+}
+
+/// The ages of the printed layers at one state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StateAges {
+    /// State index.
+    pub state: usize,
+    /// Why this state is shown, e.g. `lowest BLF`.
+    pub why: String,
+    /// Per printed layer in print order: (layer id, age s).
+    pub ages: Vec<(i32, f64)>,
 }
 
 fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), ReportError> {

@@ -53,17 +53,19 @@ mod error;
 mod html;
 mod input;
 mod island;
+mod markup;
 mod placement;
 mod plots;
 mod robot_summary;
 mod schedule;
+mod series;
 mod study;
 
 pub use demo::demo_input;
 pub use error::ReportError;
 pub use html::{
     ISLAND_SIGNIFICANT_DIGITS, REPORT_CSS, THREE_BUNDLE, THREE_LICENSE, UR10E_LICENSE,
-    UR10E_MESHES, VIEWER_JS, escape_html, escape_inline_script, render_html, scene_json,
+    UR10E_MESHES, VIEWER_JS, escape_inline_script, render_html, scene_json,
 };
 pub use input::{
     BedJoint, Bound, BoxBody, Capsule, Cell, ConstraintRow, Layer, ModeShape, Parameter, Plot,
@@ -71,6 +73,7 @@ pub use input::{
     Timeline, Vec3, WorstPlace,
 };
 pub use island::read_island;
+pub use markup::escape_html;
 pub use placement::{PlacementShapes, StationShape, placement_shapes, placement_svg};
 pub use plots::{
     CursorAxis, PLOT_SIZE, PlotFrame, PlotSpec, ReferenceLine, RenderedPlot, VerticalMarker,

@@ -12,8 +12,8 @@ use std::fmt::Write as _;
 use plotters::prelude::*;
 
 use crate::error::ReportError;
-use crate::html::escape_html;
 use crate::input::{BoxBody, ReportInput};
+use crate::markup::escape_html;
 
 /// One station in plan view, world frame, m.
 #[derive(Debug, Clone, PartialEq)]
@@ -328,7 +328,7 @@ pub fn section_html(input: &ReportInput) -> Result<String, ReportError> {
          gives the tolerance each must be placed to.</p>\n<figure aria-label=\"base placement\">{}</figure>\n\
          <table><thead><tr><th>station</th><th>base x [m]</th><th>base y [m]</th>\
          <th>base yaw [°]</th><th>layers</th></tr></thead><tbody>\n",
-        crate::html::strip_xml_declaration(&svg)
+        crate::markup::strip_xml_declaration(&svg)
     );
     for st in &shapes.stations {
         let layers = st

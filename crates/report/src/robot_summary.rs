@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ReportError;
-use crate::html::escape_html;
+use crate::markup::escape_html;
 
 /// What the robot section shows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]

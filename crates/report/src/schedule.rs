@@ -9,72 +9,12 @@
 
 use std::fmt::Write as _;
 
-use serde::{Deserialize, Serialize};
-
 use crate::error::ReportError;
-use crate::html::escape_html;
-use crate::input::{Plot, Series};
+use crate::markup::escape_html;
 use crate::plots::{CursorAxis, PlotSpec, ReferenceLine, fmt_num};
+use crate::series::{Plot, Series};
 
-/// The print schedule and what governs each state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-pub struct PrintSchedule {
-    /// Where the times come from, in words (e.g. `robot plan`, `path length / print speed`).
-    pub source: String,
-    /// One row per layer, in print order.
-    pub layers: Vec<ScheduleRow>,
-    /// Per analysed state, the utilisation of each check.
-    pub states: Vec<StateGoverning>,
-    /// The age of every printed layer at the governing state(s).
-    pub ages: Vec<StateAges>,
-}
-
-/// One layer of the schedule.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ScheduleRow {
-    /// Layer id.
-    pub layer: i32,
-    /// Start of printing, s.
-    pub start: f64,
-    /// End of printing, s.
-    pub end: f64,
-    /// Chosen wait after the layer, s.
-    pub wait: f64,
-    /// Other pause after it (station change, program change), s.
-    pub pause: f64,
-}
-
-/// The checks of one state: each check's utilisation (demand / capacity; > 1 fails).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StateGoverning {
-    /// State index (as in [`crate::PrintState::index`]).
-    pub state: usize,
-    /// `(check, utilisation)` for every check made in this state: `buckling`, `strength`,
-    /// `sliding`, `stress`, `overhang`.
-    pub checks: Vec<(String, f64)>,
-}
-
-impl StateGoverning {
-    /// The check with the largest utilisation.
-    #[must_use]
-    pub fn governing(&self) -> Option<(&str, f64)> {
-        self.checks
-            .iter()
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(c, u)| (c.as_str(), *u))
-    }
-}
-
-/// The ages of the printed layers at one state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StateAges {
-    /// State index.
-    pub state: usize,
-    /// Why this state is shown, e.g. `lowest BLF`.
-    pub why: String,
-    /// Per printed layer in print order: (layer id, age s).
-    pub ages: Vec<(i32, f64)>,
-}
+pub use crate::input::{PrintSchedule, ScheduleRow, StateAges, StateGoverning};
 
 impl PrintSchedule {
     /// Every number finite, times non-negative, every layer's end after its start.

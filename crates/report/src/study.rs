@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ReportError;
-use crate::html::escape_html;
+use crate::markup::escape_html;
 use crate::plots::fmt_num;
 
 /// A column header: key and unit.

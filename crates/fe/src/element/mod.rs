@@ -121,3 +121,16 @@ pub(crate) fn to_local(u: &[f64; 18], frame: &[[f64; 3]; 3]) -> [f64; 18] {
     }
     out
 }
+
+// Here, not in `model`, so the model (plain data) does not import the elements that read it.
+impl crate::model::ElementKind {
+    /// The element implementation.
+    pub fn implementation(self) -> Box<dyn ShellElement> {
+        match self {
+            Self::CstDkt => Box::new(cst_dkt::CstDkt),
+            Self::AndesDkt => Box::new(andes_dkt::AndesDkt),
+            Self::AndesDkmt => Box::new(dkmt::AndesDkmt),
+            Self::CstDkmt => Box::new(dkmt::CstDkmt),
+        }
+    }
+}
