@@ -9,11 +9,11 @@
 //!   (form-finding, every print state's forces), [`kappe::run::evaluate`] (stresses,
 //!   overhangs, the constraint report and the verdict, from the buckling results handed in so
 //!   far).
-//! * [`Worker`] (one per Web Worker): [`kappe::analysis::check::state_fe`], the buckling
-//!   analysis of one print state, over the runs of [`kappe::analysis::check::fe_runs`].
+//! * [`Worker`] (one per Web Worker): [`kappe::analysis::state_fe`], the buckling
+//!   analysis of one print state, over the runs of [`kappe::analysis::fe_runs`].
 //!
 //! The results cross between workers as JSON ([`FeWire`]: the fields of
-//! [`kappe::analysis::check::StateFe`], losslessly: serde_json's `float_roundtrip`).
+//! [`kappe::analysis::StateFe`], losslessly: serde_json's `float_roundtrip`).
 //!
 //! The designer plans no robot: its analysis runs on the schedule without a plan
 //! ([`kappe::schedule::cap_schedule`]: path length / print speed and the `[schedule]` waits),
@@ -24,9 +24,9 @@ pub mod page;
 
 use std::collections::BTreeMap;
 
-use kappe::analysis::buckling::{BucklingStatus, ModeGuess, StateBuckling};
-use kappe::analysis::check::{StateFe, analysis_green, fe_runs, state_fe};
-use kappe::analysis::green::WorstElement;
+use kappe::analysis::WorstElement;
+use kappe::analysis::{BucklingStatus, ModeGuess, StateBuckling};
+use kappe::analysis::{StateFe, analysis_green, fe_runs, state_fe};
 use kappe::{Cap, Design, DesignError};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -35,7 +35,7 @@ use wasm_bindgen::prelude::*;
 /// The default design file (`kappe init`'s).
 #[wasm_bindgen]
 pub fn default_toml() -> String {
-    kappe::input::design::EXAMPLE_TOML.to_string()
+    kappe::input::EXAMPLE_TOML.to_string()
 }
 
 /// One problem with a design: the dotted field it names (empty for a syntax error or a
@@ -419,7 +419,7 @@ fn view(cap: &Cap) -> Value {
 pub struct WorkerCore {
     text: String,
     cap: Option<Cap>,
-    green: Option<kappe::analysis::green::CapGreen>,
+    green: Option<kappe::analysis::CapGreen>,
     guess: Option<ModeGuess>,
 }
 

@@ -1,6 +1,6 @@
 //! `cargo bench -p kappe`: the default cap through the whole pipeline, and its stages.
 
-use kappe::form::arch::{ArchSpec, form_find_layer};
+use kappe::form::{ArchSpec, form_find_layer};
 use kappe::{Design, design_cap};
 
 fn main() {
@@ -19,7 +19,7 @@ fn default_design_all_states() -> kappe::Cap {
 
 /// Layer form-finding alone (constrained CEM inside the self-weight fixed point).
 #[divan::bench(sample_count = 50)]
-fn layer_form_finding() -> kappe::form::arch::Arch {
+fn layer_form_finding() -> kappe::form::Arch {
     let d = Design::default();
     let spec = ArchSpec {
         span: d.cap.span,

@@ -33,20 +33,20 @@ fn profile(file: &str, states: &[usize]) -> Result<(), Box<dyn std::error::Error
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for top in picks {
         let t = Instant::now();
-        let state = kappe::form::states::build_state(&cap.sections, &cap.frame, phi, top)?;
+        let state = kappe::form::build_state(&cap.sections, &cap.frame, phi, top)?;
         let t_build = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let _ = kappe::analysis::element_stresses(&state, cap.areas())?;
         let t_stress = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let reduced = match &o.grading {
-            Some(g) => kappe::analysis::graded::graded_state(&state, g),
+            Some(g) => kappe::analysis::graded_state(&state, g),
             None => state.clone(),
         };
         let t_graded = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let mat = state_material(&cap, &o, top)?;
-        let Ok(shell) = kappe::analysis::shell::state_shell(&reduced, &mat, o.row_stride) else {
+        let Ok(shell) = kappe::analysis::state_shell(&reduced, &mat, o.row_stride) else {
             continue;
         };
         let t_shell = t.elapsed().as_secs_f64();
@@ -154,7 +154,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     println!("\nmesh study, final state: BLF vs layers per mesh row");
     let last = cap.states.len() - 1;
-    let state = kappe::form::states::build_state(
+    let state = kappe::form::build_state(
         &cap.sections,
         &cap.frame,
         design.print.start_arch_fraction,
@@ -181,7 +181,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // factorization saves: states have different meshes, so kappe_fe::BucklingSolver can reuse
     // it only for models with the same mesh (e.g. another E or thickness of the same state).
     let o = AnalysisOptions::default();
-    let shell = kappe::analysis::shell::state_shell(&state, &state_material(&cap, &o, last)?, 1)
+    let shell = kappe::analysis::state_shell(&state, &state_material(&cap, &o, last)?, 1)
         .map_err(|e| format!("{e:?}"))?;
     let fe_opts = kappe_fe::BucklingOptions {
         modes: 1,

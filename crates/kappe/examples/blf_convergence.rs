@@ -14,9 +14,9 @@
 
 use std::time::Instant;
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, analyze, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::{BucklingOptions, ConvergedFactor};
 
 fn design(length: f64) -> kappe::Design {
@@ -30,7 +30,7 @@ type Level = (usize, f64, usize, f64);
 
 /// The factors of `state` on splits 1, 2, 4, … ≤ `max_split`.
 fn splits(
-    cap: &kappe::form::cap::Cap,
+    cap: &kappe::form::Cap,
     d: &kappe::Design,
     top: usize,
     max_split: usize,

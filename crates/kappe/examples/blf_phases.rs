@@ -9,9 +9,9 @@
 
 use std::time::Instant;
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::{BucklingOptions, BucklingResult};
 
 fn row(top: usize, what: &str, r: &BucklingResult, wall: f64) {

@@ -7,9 +7,9 @@
 
 use std::time::Instant;
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::{BucklingOptions, ElementKind};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

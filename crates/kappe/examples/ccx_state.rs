@@ -13,9 +13,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::{BucklingOptions, ElementKind, ShellModel, ccx};
 
 fn deck(m: &ShellModel, scale: f64) -> String {

@@ -144,7 +144,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// The `diag` table (module docs).
 fn diag() -> Result<(), Box<dyn std::error::Error>> {
-    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::analysis::{GreenOptions, check_state};
     use kappe::commands::buildability::object_shell;
     use kappe_fe::{BucklingOptions, Linearisation, PathOptions, buckling, nonlinear_path};
     let n = 12;
@@ -327,7 +327,7 @@ fn ccx_limit(
 
 /// The `ccx` table (module docs).
 fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> {
-    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::analysis::{GreenOptions, check_state};
     use kappe::commands::buildability::object_shell;
     use kappe_fe::{BucklingOptions, PathOptions, buckling, nonlinear_path, with_imperfection};
     let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));

@@ -5,12 +5,12 @@
 use std::time::Instant;
 
 use kappe::analysis::analyze;
-use kappe::analysis::collapse::cap_state_collapse;
-use kappe::input::analysis::AnalysisOptions;
-use kappe::input::nonlinear::NonlinearSpec;
+use kappe::analysis::cap_state_collapse;
+use kappe::input::AnalysisOptions;
+use kappe::input::NonlinearSpec;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let design = kappe::Design::from_toml_str(kappe::input::design::EXAMPLE_TOML)?;
+    let design = kappe::Design::from_toml_str(kappe::input::EXAMPLE_TOML)?;
     let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let off = AnalysisOptions {
         nonlinear: Some(NonlinearSpec {

@@ -9,7 +9,7 @@
 //! `KAPPE_STATES=every:N` to check every N-th state only (long caps), `KAPPE_NO_FULL=1` to time
 //! the gradings alone.
 
-use kappe::analysis::graded::Grading;
+use kappe::analysis::Grading;
 use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
 use kappe::{Design, design_cap};
 
@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut d = Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "end_wall") {
-        d.cap.end = kappe::form::ends::EndKind::EndWall;
+        d.cap.end = kappe::form::EndKind::EndWall;
     }
     let states: StateSelection = std::env::var("KAPPE_STATES")
         .ok()

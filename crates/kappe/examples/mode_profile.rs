@@ -1,8 +1,8 @@
 //! Mode-1 amplitude per row of a state's shell (issue 15: is the buckling mode local to the
 //! newest layers?). `cargo run --release -p kappe --example mode_profile -- LENGTH STATE`
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe::{Design, design_cap};
 
 fn main() {
@@ -11,7 +11,7 @@ fn main() {
     let mut d = Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "end_wall") {
-        d.cap.end = kappe::form::ends::EndKind::EndWall;
+        d.cap.end = kappe::form::EndKind::EndWall;
     }
     let cap = design_cap(&d, kappe::Context::default()).expect("design");
     let total = cap.states.len();

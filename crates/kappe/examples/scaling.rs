@@ -39,11 +39,11 @@ fn one(length: f64) -> Result<(), Box<dyn std::error::Error>> {
     let mut d = kappe::Design::default();
     d.cap.length = length;
     if std::env::var("KAPPE_END").is_ok_and(|e| e == "start_section") {
-        d.cap.end = kappe::form::ends::EndKind::StartSection;
+        d.cap.end = kappe::form::EndKind::StartSection;
     } else {
-        d.cap.end = kappe::form::ends::EndKind::EndWall;
+        d.cap.end = kappe::form::EndKind::EndWall;
     }
-    d.analysis.grading = Some(kappe::analysis::graded::Grading::default());
+    d.analysis.grading = Some(kappe::analysis::Grading::default());
     let cpu0 = measure::cpu_seconds().unwrap_or(0.0);
     let t = Instant::now();
     let cap = kappe::design_cap(&d, kappe::Context::default())?;

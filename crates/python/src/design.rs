@@ -22,7 +22,7 @@ pub(crate) fn default_design_toml() -> PyResult<String> {
 /// The commented example design file (`kappe init`).
 #[pyfunction]
 pub(crate) fn example_design_toml() -> &'static str {
-    kappe::input::design::EXAMPLE_TOML
+    kappe::input::EXAMPLE_TOML
 }
 
 /// Parse and validate a design given as TOML text; returns its complete TOML (every field).
@@ -208,8 +208,7 @@ impl PyOutcome {
 
     /// The final state's network (JSON text, network.json).
     fn network_json(&self) -> PyResult<String> {
-        let v =
-            kappe::output::network::network_json(&self.out.cap).map_err(|e| design_error(&e))?;
+        let v = kappe::output::network_json(&self.out.cap).map_err(|e| design_error(&e))?;
         serde_json::to_string(&v).map_err(|e| json_err("network", e))
     }
 

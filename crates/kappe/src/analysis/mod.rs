@@ -28,17 +28,17 @@
 //! green material's modulus by layer age), [`buckling`] (the shell buckling run of one state)
 //! and [`check`] ([`analyze`]: every state against every constraint, and the report).
 
-pub mod asprinted;
-pub mod blf_sensitivity;
-pub mod buckling;
-pub mod check;
-pub mod collapse;
-pub mod convergence;
-pub mod graded;
-pub mod green;
-pub mod reliability;
-pub mod shell;
-pub mod stress;
+pub(crate) mod asprinted;
+pub(crate) mod blf_sensitivity;
+pub(crate) mod buckling;
+pub(crate) mod check;
+pub(crate) mod collapse;
+pub(crate) mod convergence;
+pub(crate) mod graded;
+pub(crate) mod green;
+pub(crate) mod reliability;
+pub(crate) mod shell;
+pub(crate) mod stress;
 
 pub use crate::form::overhang::layer_overhangs;
 pub use crate::input::ageing::Ageing;
@@ -49,3 +49,14 @@ pub use buckling::{
 };
 pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
 pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
+
+// The items users outside the crate need (the CLI, Python, the designer, the tests).
+pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment};
+pub use blf_sensitivity::{blf_derivatives, time_state_blf};
+pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
+pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
+pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
+pub use graded::{Grading, graded_rows, graded_state};
+pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
+pub use reliability::{Check, Vars, check_form, limit_state};
+pub use shell::state_shell;

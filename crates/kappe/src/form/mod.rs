@@ -4,15 +4,24 @@
 //! layers' overhang ([`overhang`]), the print path ([`path`]) and the printed beads
 //! ([`beads`]); [`cap`] ties them into a [`Cap`]. Imports only [`crate::input`].
 
-pub mod arch;
-pub mod beads;
-pub mod cap;
-pub mod ends;
-pub mod forces;
-pub mod frame;
-pub mod overhang;
-pub mod path;
-pub mod section;
-pub mod states;
+pub(crate) mod arch;
+pub(crate) mod beads;
+pub(crate) mod cap;
+pub(crate) mod ends;
+pub(crate) mod forces;
+pub(crate) mod frame;
+pub(crate) mod overhang;
+pub(crate) mod path;
+pub(crate) mod section;
+pub(crate) mod states;
 
 pub use cap::{Cap, StateSummary, design_cap};
+
+// The items users outside the crate need (the CLI, Python, the designer, the tests).
+pub use arch::{Arch, ArchSpec, Catenary, form_find_layer};
+pub use ends::{EndKind, stack_thrust, wall_load};
+pub use forces::{Sections2D, state_forces};
+pub use frame::{LayerFrame, V3};
+pub use overhang::{layer_overhangs, measured_overhangs};
+pub use section::{NodeKind, Sections, build_sections_with_end};
+pub use states::{Role, build_state};

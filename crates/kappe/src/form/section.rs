@@ -88,26 +88,6 @@ impl Sections {
     }
 }
 
-/// Build the centre and start sections from the layer-0 arch (a start-section end).
-pub fn build_sections(
-    arch: &Arch,
-    frame: &LayerFrame,
-    length: f64,
-    layer_height: f64,
-    phi: f64,
-    half_chord_weight: impl Fn(f64) -> f64,
-) -> Result<Sections, DesignError> {
-    build_sections_with_end(
-        arch,
-        frame,
-        length,
-        layer_height,
-        phi,
-        half_chord_weight,
-        EndKind::StartSection,
-    )
-}
-
 /// N = round(Cl·cos(am) / lh), at least 1.
 pub fn centre_layer_count(length: f64, frame: &LayerFrame, layer_height: f64) -> usize {
     ((length * frame.tilt.cos() / layer_height).round() as usize).max(1)

@@ -3,17 +3,24 @@
 //! ([`analysis`]), the schedule's waits ([`schedule`]), and the one error type of the pipeline
 //! ([`DesignError`]). Nothing here knows about any later stage.
 
-pub mod ageing;
-pub mod analysis;
-pub mod context;
-pub mod design;
-pub mod error;
-pub mod material;
-pub mod nonlinear;
-pub mod resolve;
-pub mod schedule;
-pub mod uncertainty;
+pub(crate) mod ageing;
+pub(crate) mod analysis;
+pub(crate) mod context;
+pub(crate) mod design;
+pub(crate) mod error;
+pub(crate) mod material;
+pub(crate) mod nonlinear;
+pub(crate) mod resolve;
+pub(crate) mod schedule;
+pub(crate) mod uncertainty;
 
 pub use context::Context;
 pub use design::Design;
 pub use error::DesignError;
+
+// The items users outside the crate need (the CLI, Python, the designer, the tests).
+pub use analysis::AnalysisOptions;
+pub use design::EXAMPLE_TOML;
+pub use material::{TimeLaw, TimeModel, TimeModelSpec};
+pub use nonlinear::NonlinearSpec;
+pub use uncertainty::BETA_MIN_DEFAULT;

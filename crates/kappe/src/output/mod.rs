@@ -7,12 +7,12 @@
 //!
 //! [`Outcome::files`]: crate::Outcome::files
 
-pub mod dir;
+pub(crate) mod dir;
 mod files;
-pub mod network;
-pub mod report_input;
-pub mod schedule_report;
-pub mod summary;
+pub(crate) mod network;
+pub(crate) mod report_input;
+pub(crate) mod schedule_report;
+pub(crate) mod summary;
 
 pub use dir::{
     MANIFEST, PreparedDir, check_user_file, prepare_dir, write_file_atomic, write_user_file,
@@ -38,3 +38,7 @@ pub enum OutputError {
 
 /// Results of this module.
 pub type Result<T> = std::result::Result<T, OutputError>;
+
+// The items users outside the crate need (the CLI, Python, the designer, the tests).
+pub use network::network_json;
+pub use summary::{Summary, summary_schema};

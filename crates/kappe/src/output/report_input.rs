@@ -242,18 +242,6 @@ fn row_of(c: &crate::analysis::ConstraintResult) -> Option<ConstraintRow> {
     })
 }
 
-/// The arm posed along the robot plan (`crate::robot_plan::arm_frames`) as the report's
-/// animation (capsules; the report draws the UR10e meshes from [`plan_animation`] instead).
-pub fn robot_animation(frames: &crate::robot_plan::ArmFrames) -> RobotAnimation {
-    RobotAnimation {
-        times: frames.times.clone(),
-        joints: frames.joints.clone(),
-        link_radii: frames.radii.clone(),
-        poses: frames.segments.clone(),
-        ..RobotAnimation::default()
-    }
-}
-
 /// Every waypoint of `plan` as the report's animation (joints and station per frame; a second
 /// frame at the end of a hold, so the arm waits where the plan waits), and the arrival time of
 /// each waypoint by (layer id, point index). About 32 bytes per frame in the page.

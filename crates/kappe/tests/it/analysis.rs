@@ -7,12 +7,12 @@
 //! final-state BLF changes by < 0.3 % between 1 and 4 layers per row, and the designs tested
 //! with 8 are far from their limits.
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{
     Ageing, AnalysisOptions, BucklingStatus, ElementKind, StateSelection, analyze,
     element_stresses, state_buckling, state_material,
 };
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe::{Cap, Design, design_cap};
 
 /// Final state only, 4 layers per mesh row.
@@ -151,7 +151,7 @@ fn single_layer_crown_stress_matches_catenary() {
         .unwrap();
     let d = &c.design;
     let tilt = d.tilt();
-    // Closed form, solved here independently of kappe::form::arch::Catenary by bisection.
+    // Closed form, solved here independently of kappe::form::Catenary by bisection.
     let (span, rise, gamma) = (d.cap.span, d.cap.rise, d.material.specific_weight);
     let r = rise / tilt.cos();
     let (mut lo, mut hi) = (0.01, 100.0);

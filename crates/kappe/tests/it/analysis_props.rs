@@ -4,7 +4,7 @@
 
 use kappe::Design;
 use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 
 fn small() -> Design {
     let mut d = Design::default();

@@ -2,7 +2,7 @@
 //! against its closed forms (staged, all at once, infinitely stiffening), the equilibrium of
 //! every increment, and the cap's as-printed pass.
 
-use kappe::analysis::asprinted::{Increment, NodeKey, accumulate, increment};
+use kappe::analysis::{Increment, NodeKey, accumulate, increment};
 use kappe_fe::{Material, NodalLoad, ShellModel, Support};
 
 const H: f64 = 0.01; // layer height, m
@@ -205,8 +205,7 @@ fn the_cap_as_printed_pass_reports_every_state() {
     assert_eq!(row.state, p.state);
     assert_eq!(row.limit, design.deviation_max());
     // Deterministic: a second pass (new hash maps, other thread timing) gives the same bits.
-    let again = kappe::analysis::asprinted::cap_as_printed(&cap, &options, None, &|| Ok(()))
-        .expect("again");
+    let again = kappe::analysis::cap_as_printed(&cap, &options, None, &|| Ok(())).expect("again");
     assert_eq!(&again, p);
     // A crown never sinks by more than the largest deviation.
     for s in &p.states {
@@ -219,8 +218,8 @@ fn the_cap_as_printed_pass_reports_every_state() {
     ))
     .expect("design");
     let cap4 = kappe::design_cap(&stiff, kappe::Context::default()).expect("cap");
-    let p4 = kappe::analysis::asprinted::cap_as_printed(&cap4, &options, None, &|| Ok(()))
-        .expect("as-printed");
+    let p4 =
+        kappe::analysis::cap_as_printed(&cap4, &options, None, &|| Ok(())).expect("as-printed");
     // Same geometry, K scaled by 4: the deviation scales by 1/4 to round-off (1e-9).
     assert!(
         (4.0 * p4.deviation_m / top - 1.0).abs() < 1e-9,
@@ -252,7 +251,7 @@ fn a_deviation_above_deviation_max_fails_the_design_with_its_levers() {
     assert!(!row.pass && row.element.starts_with("layer "), "{row:?}");
     let report = a.report();
     assert!(report.contains("deviation_max FAIL"), "{report}");
-    assert!(report.contains(kappe::analysis::check::levers("deviation_max")));
+    assert!(report.contains(kappe::analysis::levers("deviation_max")));
     assert!(a.states.iter().any(|s| !s.ok));
     let v = kappe::verdict::verdict(&cap, Some(&a), Default::default());
     assert!(v.failures.iter().any(|f| matches!(
@@ -280,7 +279,7 @@ fn the_collapse_curve_runs_up_to_the_collapse_factor() {
         .collapse
         .expect("collapse");
     let curve = &c.curve;
-    assert!(!curve.is_empty() && curve.len() <= kappe::analysis::collapse::CURVE_POINTS);
+    assert!(!curve.is_empty() && curve.len() <= kappe::analysis::CURVE_POINTS);
     // Every point but the last lies below the collapse factor: the curve stops at the first
     // step at or past it.
     for p in &curve[..curve.len() - 1] {
@@ -288,7 +287,7 @@ fn the_collapse_curve_runs_up_to_the_collapse_factor() {
     }
     // The curve's deflection at the last step with λ ≤ 1 is the path's own sag at λ ≤ 1
     // (`deflection_at_1`, computed separately along the path), when the curve is not thinned.
-    if c.steps <= kappe::analysis::collapse::CURVE_POINTS
+    if c.steps <= kappe::analysis::CURVE_POINTS
         && let Some(p) = curve.iter().rev().find(|p| p[0] <= 1.0)
     {
         assert_eq!(p[1], c.deflection_at_1);

@@ -1,9 +1,9 @@
 //! The converged buckling factor (issue 23, docs/convergence.md): a cheap sample of
 //! `examples/blf_convergence.rs`.
 
-use kappe::analysis::shell::state_shell;
+use kappe::analysis::state_shell;
 use kappe::analysis::{AnalysisOptions, analyze, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::BucklingOptions;
 
 /// Factors of a state of `d` on its print-layer mesh split 1, 2 and 4 times per edge.
@@ -114,7 +114,7 @@ fn sampled_states_match_every_state_solved() {
 /// at most triples that (3e-5), rounded up.
 #[test]
 fn the_split_pass_continues_from_the_first_pass() {
-    use kappe::analysis::buckling::{state_buckling_mode, state_buckling_warm, state_refine};
+    use kappe::analysis::{state_buckling_mode, state_buckling_warm, state_refine};
     let d = kappe::Design::default();
     let cap = kappe::design_cap(&d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions::default();

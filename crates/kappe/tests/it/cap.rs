@@ -2,7 +2,7 @@
 //! independently of the pipeline's own bookkeeping (equilibrium is re-summed from the exported
 //! network, geometry from the layer planes and translations).
 
-use kappe::form::states::{Role, build_state};
+use kappe::form::{Role, build_state};
 use kappe::{Cap, Design, design_cap};
 use nalgebra::Vector3;
 
@@ -23,7 +23,7 @@ fn design(span: f64, rise: f64, tilt: f64, length: f64) -> Design {
 
 /// Re-sum `q + Σ F·û + R` at every node of the exported final network.
 fn network_residual(cap: &Cap) -> (f64, f64) {
-    let doc = kappe::output::network::network_json(cap).unwrap();
+    let doc = kappe::output::network_json(cap).unwrap();
     let nodes = doc["nodes"].as_array().unwrap();
     let xyz = |i: usize| -> V3 {
         let a = &nodes[i]["xyz"];
@@ -164,7 +164,7 @@ fn check_invariants(d: &Design) {
             // Start layer −m: trimmed translate of layer 0 by T_m; feet on the base plane.
             let t = cap.sections.translations[(-layer.id) as usize];
             for node in &layer.nodes[1..layer.nodes.len() - 1] {
-                let kappe::form::section::NodeKind::Column(i) = node.kind else {
+                let kappe::form::NodeKind::Column(i) = node.kind else {
                     panic!("interior foot")
                 };
                 assert!(
@@ -358,7 +358,7 @@ fn bad_fields_are_named_with_their_range() {
 #[test]
 fn the_example_file_is_the_default_design() {
     assert_eq!(
-        Design::from_toml_str(kappe::input::design::EXAMPLE_TOML).unwrap(),
+        Design::from_toml_str(kappe::input::EXAMPLE_TOML).unwrap(),
         Design::default()
     );
 }

@@ -22,7 +22,7 @@ fn three_bay_ceiling_end_to_end() {
         let am = d.tilt();
         let expect = 0.25 - d.cap.rise * am.tan() - d.print.layer_height / am.cos();
         assert!((d.cap.length - expect).abs() < 1e-12);
-        assert_eq!(d.cap.end, kappe::form::ends::EndKind::EndWall);
+        assert_eq!(d.cap.end, kappe::form::EndKind::EndWall);
     }
     let out = run_ceiling(&c, &kappe::Options::of(&designs[0]), &|_, _| {
         std::ops::ControlFlow::Continue(())

@@ -1,10 +1,10 @@
 //! The collapse factor of print states (docs/collapse.md): the limit w0 → 0, the ordering in
 //! w0 and in the base restraint, and the input checks of `[analysis.nonlinear]`.
 
-use kappe::analysis::collapse::CollapseMode;
-use kappe::analysis::green::FailureMode;
+use kappe::analysis::CollapseMode;
+use kappe::analysis::FailureMode;
 use kappe::commands::buildability::{BuildabilitySpec, EXAMPLE_TOML, Resolved, check_layers};
-use kappe::input::error::DesignError;
+use kappe::input::DesignError;
 
 /// The Wolfs cylinder (the `kappe init --kind buildability` example) with 24 segments instead
 /// of 48, to keep the test quick, and the given `[analysis.nonlinear]` lines.
@@ -69,7 +69,7 @@ fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
 /// −0.42 %; without the facets' local von Kármán terms +4.9 % on all three).
 #[test]
 fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
-    use kappe::analysis::green::{GreenOptions, check_state};
+    use kappe::analysis::{GreenOptions, check_state};
     use kappe::commands::buildability::object_shell;
     use kappe_fe::{BucklingOptions, Linearisation, buckling, linearised_critical_factor};
     let n = 12;

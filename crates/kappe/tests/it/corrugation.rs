@@ -2,8 +2,8 @@
 //! tilted plane; amplitude 0 is the prismatic cap byte for byte; the overhang is measured on the
 //! real geometry; bad waves are named errors or failing constraints.
 
-use kappe::form::frame::V3;
-use kappe::form::overhang::{layer_overhangs, measured_overhangs};
+use kappe::form::V3;
+use kappe::form::{layer_overhangs, measured_overhangs};
 use kappe::{Design, DesignError, design_cap};
 
 /// A small cap (12 centre layers of 15 mm) so the tests stay quick; the wave's wavelength is

@@ -2,12 +2,12 @@
 //! method.md §5, column by column, checked against the closed form and by equilibrium.
 
 use kappe::Design;
-use kappe::form::arch::{ArchSpec, form_find_layer};
-use kappe::form::ends::{EndKind, stack_thrust, wall_load};
-use kappe::form::forces::{Sections2D, state_forces};
-use kappe::form::frame::{LayerFrame, V3};
-use kappe::form::section::{NodeKind, Sections, build_sections_with_end};
-use kappe::form::states::{Role, build_state};
+use kappe::form::{ArchSpec, form_find_layer};
+use kappe::form::{EndKind, stack_thrust, wall_load};
+use kappe::form::{LayerFrame, V3};
+use kappe::form::{NodeKind, Sections, build_sections_with_end};
+use kappe::form::{Role, build_state};
+use kappe::form::{Sections2D, state_forces};
 
 /// The sections of `d` with the given end, built as the pipeline builds them.
 fn sections(d: &Design, end: EndKind) -> (Sections, LayerFrame, Sections2D) {

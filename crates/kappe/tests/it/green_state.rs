@@ -2,9 +2,9 @@
 //! straight wall (Greenhill, linear curing, plastic collapse), the time model and the bad-input
 //! errors. Every tolerance is stated and justified where it is used.
 
-use kappe::analysis::green::FailureMode;
+use kappe::analysis::FailureMode;
 use kappe::commands::buildability::{BuildabilitySpec, Resolved, check_layers, run};
-use kappe::input::material::TimeModelSpec;
+use kappe::input::TimeModelSpec;
 
 /// A wall spec: length 0.2 m, thickness t, layer height h, `n` layers, ν = 0, γ = 20 kN/m³.
 fn wall(t: f64, h: f64, n: usize, time: &str, extra: &str) -> String {
@@ -200,7 +200,7 @@ fn wolfs_cylinder_plastic_estimate() {
 #[test]
 fn time_model_laws_and_mohr_coulomb() {
     let lin = TimeModelSpec {
-        model: Some(kappe::input::material::TimeLaw::Linear),
+        model: Some(kappe::input::TimeLaw::Linear),
         youngs_modulus: Some(100.0),
         youngs_modulus_rate: Some(2.0),
         cohesion: Some(1000.0),
@@ -225,7 +225,7 @@ fn time_model_laws_and_mohr_coulomb() {
     );
     // The exponential law starts with the same rate and accelerates; t_c → ∞ is linear.
     let exp = TimeModelSpec {
-        model: Some(kappe::input::material::TimeLaw::Exponential),
+        model: Some(kappe::input::TimeLaw::Exponential),
         youngs_modulus: Some(100.0),
         youngs_modulus_rate: Some(2.0),
         time_constant: Some(60.0),
@@ -444,10 +444,7 @@ fn cap_reports_strength_and_sliding_with_ages() {
 /// Per analysed state: (BLF, strength utilisation, sliding utilisation).
 type GreenRow = (Option<f64>, Option<f64>, Option<f64>);
 
-fn green_rows(
-    design: &kappe::Design,
-    grading: Option<kappe::analysis::graded::Grading>,
-) -> Vec<GreenRow> {
+fn green_rows(design: &kappe::Design, grading: Option<kappe::analysis::Grading>) -> Vec<GreenRow> {
     let cap = kappe::design_cap(design, kappe::Context::default()).expect("cap");
     let mut options = design.analysis.clone();
     options.states = "every:4".parse().expect("selection");
@@ -472,7 +469,7 @@ fn graded_mesh_with_the_strength_model_matches_the_full_mesh() {
          youngs_modulus_rate = 2000.0\ncohesion = 10000.0\nfriction_angle_deg = 20.0\n",
     )
     .expect("design");
-    let g = kappe::analysis::graded::Grading::default();
+    let g = kappe::analysis::Grading::default();
     let full = green_rows(&design, None);
     let graded = green_rows(&design, Some(g));
     assert_eq!(full.len(), graded.len());

@@ -2,9 +2,9 @@
 //! the exact scalings against a re-solve, FORM against Monte Carlo, and no change without the
 //! table.
 
-use kappe::analysis::reliability::{Check, Vars, check_form, limit_state};
 use kappe::analysis::{AnalysisOptions, StateSelection, state_buckling, state_material};
-use kappe::form::states::build_state;
+use kappe::analysis::{Check, Vars, check_form, limit_state};
+use kappe::form::build_state;
 use kappe::{Design, Options, design_cap, no_progress, run};
 use kappe_reliability::{SamplingOptions, WithGradient, monte_carlo};
 
@@ -250,14 +250,8 @@ fn blf_sensitivity_of_an_aged_wall_matches_finite_differences() {
     let r = tight_blf(&m);
     let lambda = r.factors[0];
     let de = vec![vec![1.0; ages.len()], ages.clone()];
-    let d = kappe::analysis::blf_sensitivity::blf_derivatives(
-        &m,
-        lambda,
-        &r.modes[0],
-        &r.static_result,
-        &de,
-    )
-    .unwrap();
+    let d =
+        kappe::analysis::blf_derivatives(&m, lambda, &r.modes[0], &r.static_result, &de).unwrap();
     for (k, (p, name)) in [(e0, "E0"), (rate, "rate")].into_iter().enumerate() {
         let h = 1e-4 * p;
         let at = |s: f64| {
@@ -288,27 +282,20 @@ fn blf_sensitivity_of_an_aged_wall_matches_finite_differences() {
 #[test]
 fn blf_sensitivity_of_a_cap_state_matches_finite_differences() {
     let mut d = small();
-    d.material.time = Some(kappe::input::material::TimeModelSpec {
-        model: Some(kappe::input::material::TimeLaw::Linear),
+    d.material.time = Some(kappe::input::TimeModelSpec {
+        model: Some(kappe::input::TimeLaw::Linear),
         youngs_modulus: Some(2.0e6),
         youngs_modulus_rate: Some(2.0e4),
         ..Default::default()
     });
     let cap = design_cap(&d, kappe::Context::default()).unwrap();
-    let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
     let last = cap.states.len() - 1;
     let time = d.time_model().unwrap();
-    let solve = |t: &kappe::input::material::TimeModel| {
-        kappe::analysis::blf_sensitivity::time_state_blf(
-            &cap,
-            &d.analysis,
-            &green.schedule,
-            t,
-            last,
-            1e-12,
-        )
-        .unwrap()
-        .unwrap()
+    let solve = |t: &kappe::input::TimeModel| {
+        kappe::analysis::time_state_blf(&cap, &d.analysis, &green.schedule, t, last, 1e-12)
+            .unwrap()
+            .unwrap()
     };
     let (lambda, dl) = solve(&time);
     let ages = green.schedule.ages(last + 1);
@@ -370,7 +357,7 @@ fn study14(percent_per_hour: Option<f64>) -> Design {
 #[test]
 fn study14_drying_mix_and_the_waits_that_keep_beta() {
     use kappe::commands::least_waits::{check_state_on, least_waits};
-    let beta_min = kappe::input::uncertainty::BETA_MIN_DEFAULT;
+    let beta_min = kappe::input::BETA_MIN_DEFAULT;
     // Nominal values: every state passes without a wait.
     let mut nominal = study14(None);
     nominal.uncertainty = None;
@@ -385,7 +372,7 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
     // state 1.39); the earlier ones have β > 4 either way.
     let last_betas = |d: &Design| -> Vec<f64> {
         let cap = design_cap(d, kappe::Context::default()).unwrap();
-        let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+        let green = kappe::analysis::CapGreen::new(&cap).unwrap();
         let n = cap.states.len();
         (n - 4..n)
             .map(|q| {
@@ -410,7 +397,7 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
     let plan = least_waits(&cap, &drying.analysis, 600.0, &|_| {}).unwrap();
     assert!(plan.infeasible.is_empty(), "{:?}", plan.infeasible);
     assert!(plan.schedule.total_wait_s() > 0.0, "no wait was needed");
-    let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
     for q in 0..cap.states.len() {
         let c = check_state_on(&cap, &green, &drying.analysis, &plan.schedule, q).unwrap();
         assert!(c.pass, "state {q} on the final schedule: {c:?}");

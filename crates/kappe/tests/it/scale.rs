@@ -9,8 +9,8 @@
 //! `cargo run --release -p kappe --example graded_check -- 0.6` (and `-- 1.2`,
 //! `KAPPE_END=end_wall … -- 1.2`), whose numbers are in the `kappe::analysis::graded` docs.
 
-use kappe::analysis::graded::{Grading, graded_rows};
 use kappe::analysis::{AnalysisOptions, StateSelection, analyze};
+use kappe::analysis::{Grading, graded_rows};
 use kappe::{Design, design_cap};
 
 fn blfs(d: &Design, every: usize, grading: Option<Grading>) -> Vec<Option<f64>> {
@@ -40,7 +40,7 @@ fn governing(v: &[Option<f64>]) -> usize {
 
 #[test]
 fn graded_mesh_matches_the_full_mesh() {
-    use kappe::form::ends::EndKind;
+    use kappe::form::EndKind;
     for (length, end, every) in [
         (0.6, EndKind::StartSection, 8),
         (1.2, EndKind::StartSection, 24),

@@ -2,7 +2,7 @@
 //! default, the Kirchhoff CST+DKT selectable in the design file's `[analysis]`.
 
 use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
-use kappe::form::states::build_state;
+use kappe::form::build_state;
 use kappe_fe::ElementKind;
 
 /// `[analysis] element` parses by name; the default is ANDES+DKMT; unknown names are errors

@@ -1,6 +1,6 @@
 //! `summary.json` is a typed struct with a published JSON Schema (issue 22).
 
-use kappe::output::summary::{Summary, summary_schema};
+use kappe::output::{Summary, summary_schema};
 
 fn published_path() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/formats/summary.schema.json")
@@ -20,7 +20,7 @@ fn the_published_schema_is_the_generated_one() {
     let published = std::fs::read_to_string(published_path()).unwrap();
     assert!(
         published == generated,
-        "docs/formats/summary.schema.json is not the schema of kappe::output::summary::Summary; \
+        "docs/formats/summary.schema.json is not the schema of kappe::output::Summary; \
          rerun this test with KAPPE_BLESS=1 and commit the file"
     );
 }
