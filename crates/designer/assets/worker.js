@@ -1,6 +1,6 @@
 // Kappe designer Web Worker (appended to the wasm-bindgen glue in a Blob URL): the buckling
 // analysis of the print states of one run of `fe_runs`, by `kappe_designer::Worker`
-// (kappe::analysis::check::state_fe). Messages in: { module } once, then
+// (kappe::analysis::state_fe). Messages in: { module } once, then
 // { generation, text, run }. Out: { generation, result } per state, { done } per run.
 let worker = null;
 self.onmessage = (ev) => {
