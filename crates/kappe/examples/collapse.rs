@@ -172,6 +172,7 @@ fn diag() -> Result<(), Box<dyn std::error::Error>> {
             &ages,
             &r.time,
             &GreenOptions::default(),
+            None,
         )?;
         let model = kappe_fe::refine::split(&model, split).model;
         let lba = buckling(
@@ -340,6 +341,7 @@ fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> 
         &ages,
         &r.time,
         &GreenOptions::default(),
+        None,
     )?;
     let dir = std::path::Path::new("target/ccx_collapse");
     std::fs::create_dir_all(dir)?;

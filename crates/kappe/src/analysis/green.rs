@@ -158,27 +158,20 @@ impl GreenState {
     }
 }
 
-/// Check one state (see the module docs). `model` holds the geometry, thickness, supports and
-/// the base material (ν, γ); its materials are replaced by the aged ones. `ages[k]` is the age of
-/// the layer with print index k, s.
-pub fn check_state(
-    model: &mut ShellModel,
-    elements: &[ElementLayers],
-    ages: &[f64],
-    time: &TimeModel,
-    options: &GreenOptions,
-) -> Result<GreenState, DesignError> {
-    check_state_warm(model, elements, ages, time, options, None).map(|(g, _)| g)
-}
-
 /// Mode 1 of a state per shell node (`[ux, uy, uz, rx, ry, rz]`, any scale): the start of the
-/// next state's eigensolve ([`check_state_warm`]).
+/// next state's eigensolve ([`check_state`]).
 pub type ModeStart = Vec<[f64; 6]>;
 
-/// [`check_state`] with the Lanczos iteration started from `start` (e.g. the previous state's
-/// mode mapped onto this mesh) and this state's mode returned for the next one. The start saves
-/// steps only: the result meets the same residual bound (`kappe_fe::BucklingOptions::start`).
-pub fn check_state_warm(
+/// Check one state (see the module docs). `model` holds the geometry, thickness, supports and
+/// the base material (ν, γ); its materials are replaced by the aged ones. `ages[k]` is the age of
+/// the layer with print index k, s. The Lanczos iteration starts from `start` when given (e.g.
+/// the previous state's mode mapped onto this mesh), and this state's mode is returned for the
+/// next one. The start saves steps only: the result meets the same residual bound
+/// (`kappe_fe::BucklingOptions::start`).
+///
+/// # Errors
+/// An invalid time model at an age, a model the solver refuses.
+pub fn check_state(
     model: &mut ShellModel,
     elements: &[ElementLayers],
     ages: &[f64],

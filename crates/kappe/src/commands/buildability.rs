@@ -1,6 +1,6 @@
 //! Buildability of the standard test objects (green-state.md §3–5): a free-standing straight
 //! wall or a cylinder printed layer by layer on the bed, every layer count n = 1, 2, … checked
-//! with the green-state check of the cap ([`crate::analysis::green::check_state`]: the time model, the
+//! with the green-state check of the cap ([`crate::analysis::check_state`]: the time model, the
 //! shell FE, strength and bed-joint sliding). Only the geometry differs from the cap.
 //!
 //! **Mesh.** One shell row per bed joint: rows at z = 0, h, …, n·h on the centre line (wall:
@@ -25,7 +25,7 @@ use kappe_fe::{Material, ShellModel, Support};
 use crate::analysis::collapse::{Collapse, CollapseMode, CollapseOptions, collapse_factor};
 use crate::analysis::green::{
     BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement,
-    check_state_warm,
+    check_state,
 };
 use crate::input::error::DesignError;
 use crate::input::material::{TimeModel, TimeModelSpec};
@@ -539,7 +539,7 @@ pub fn check_layers_warm(
         sliding: c.sliding,
         ..Default::default()
     };
-    let (g, mode) = check_state_warm(&mut model, &layers, &ages, &r.time, &opts, start)?;
+    let (g, mode) = check_state(&mut model, &layers, &ages, &r.time, &opts, start)?;
     let o = &r.spec.object;
     let collapse = match (r.spec.nonlinear(), g.blf()) {
         (Some(nl), Some(blf)) => {

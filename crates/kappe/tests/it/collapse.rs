@@ -82,6 +82,7 @@ fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
         &ages,
         &r.time,
         &GreenOptions::default(),
+        None,
     )
     .unwrap();
     let model = kappe_fe::refine::split(&model, 2).model;
