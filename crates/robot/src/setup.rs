@@ -106,7 +106,7 @@ pub struct BaseSearch {
 
 impl Default for BaseSearch {
     /// In front of the printing front on the cap's centre line: x = 0, y as in
-    /// [`BaseSearch::y`], 0.1 m steps, yaw 270° (base x axis pointing to −y, the mobile base body
+    /// [`BaseSearch::y`], 25 mm steps, yaw 270° (base x axis pointing to −y, the mobile base body
     /// extending away from the cap), base at z = 0 (top plate of the mobile base, 0.70 m
     /// above the floor). With a 1.3 m reach, the tool pointing along −n and a 0.8 m span, a base
     /// beside the span cannot reach the far springing, hence the centre line.
@@ -114,7 +114,10 @@ impl Default for BaseSearch {
         BaseSearch {
             x: [0.0, 0.0],
             y: None,
-            step: 0.1,
+            // 25 mm, not 0.1 m: the 0.1 m grid missed the one pose (y = 1.029 m) from which
+            // the default cap prints in one station, and split it into three with two 0.1 m
+            // drives; the grid is one row along y, so the finer step costs no more wall time.
+            step: 0.025,
             yaw_deg: vec![270.0],
             z: 0.0,
             score_stride: 5,

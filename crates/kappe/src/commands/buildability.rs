@@ -24,8 +24,7 @@ use kappe_fe::{Material, ShellModel, Support};
 
 use crate::analysis::collapse::{Collapse, CollapseMode, CollapseOptions, collapse_factor};
 use crate::analysis::green::{
-    BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement,
-    check_state,
+    BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement, check_state,
 };
 use crate::input::error::DesignError;
 use crate::input::material::{TimeModel, TimeModelSpec};
