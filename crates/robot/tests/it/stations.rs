@@ -221,34 +221,3 @@ fn schedule_of_a_two_station_plan() {
     );
 }
 
-/// The base search with a margin (issue 28): a layer counts as covered by a candidate pose only
-/// when it is also reachable from every corner of the tolerance box, so every station of the
-/// searched plan must survive the tolerance check with that box — the search's contract, checked
-/// here by the independent tolerance check (which re-solves every waypoint from each corner
-/// rather than re-using the search's coverage count). A print long enough to need more than one
-/// station (120 layers of 8 mm = 0.96 m along the beams) exercises the station ends, where a
-/// nominal search would stop at the edge of the reach.
-#[test]
-fn searched_stations_with_a_margin_survive_their_tolerance() {
-    let layers = cap_path(0.8, 0.2, 25.0, 0.008, 120, 12);
-    let tol = BaseTolerance::default();
-    let search = |margin: Option<BaseTolerance>| RobotSetup {
-        base: BasePlacement::Search(BaseSearch {
-            margin,
-            ..BaseSearch::default()
-        }),
-        ..RobotSetup::default()
-    };
-    let plan = plan_print(&layers, &search(Some(tol.clone())), &PlanOptions::default()).unwrap();
-    assert!(check_plan(&plan).problems.is_empty());
-    let rep = check_base_tolerance(&plan, &tol);
-    assert!(rep.ok(), "{:?}", rep.problems);
-    // Every layer printed once, in order, across the stations.
-    let printed: Vec<i64> = plan
-        .stations
-        .iter()
-        .flat_map(|s| s.layers.iter().map(|l| l.layer))
-        .collect();
-    let expected: Vec<i64> = layers.iter().map(|l| l.layer).collect();
-    assert_eq!(printed, expected);
-}
