@@ -10,7 +10,9 @@
 //! * [`buckling`] → [`BucklingResult`]: lowest positive factors λ of `(K + λ K_G) φ = 0`, their
 //!   modes, residuals and a Sturm-count proof that no lower factor was missed.
 //! * [`BucklingSolver`] caches the symbolic factorization for models with the same mesh and
-//!   supports (e.g. the ~100 print states of a vault).
+//!   supports (e.g. the ~100 print states of a vault);
+//!   [`BucklingSolver::buckling_with_weight_case`] also solves a second load case (part of the
+//!   self-weight) on the buckling solve's own factor of K.
 //! * [`element::ShellElement`] is the element boundary; [`element::cst_dkt::CstDkt`] the
 //!   reference element (default), [`element::andes_dkt::AndesDkt`] the ANDES/OPT membrane with
 //!   drilling freedoms + DKT, [`element::dkmt::AndesDkmt`] / [`element::dkmt::CstDkmt`] the

@@ -296,7 +296,6 @@ impl BucklingSolver {
         stats.t_assembly = t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
-        let n = self.dofs.n_free();
         let kdiag = self.diagonal(&kvals);
         let llt = match self.symbolic.llt(&self.pattern, &kvals) {
             Ok(l) => l,
@@ -312,6 +311,31 @@ impl BucklingSolver {
         if ratio < 1e-13 {
             return Err(self.mechanism(&kvals, &kdiag, Some(at)));
         }
+        stats.t_factor = t1.elapsed().as_secs_f64();
+        let result = self.static_solve(model, &llt, &f, &geo, stats)?;
+        Ok(StaticInternal {
+            result,
+            llt,
+            kvals,
+            geo,
+        })
+    }
+
+    /// The static solution of `model` under the load vector `f` (all DOFs, as
+    /// `load_vector`) with the factor `llt` of its K: displacements, resultants, reactions.
+    /// `stats` gets the solve's time in `t_factor` and the recovery's in `t_geometric`.
+    fn static_solve(
+        &self,
+        model: &ShellModel,
+        llt: &Llt<'_>,
+        f: &[f64],
+        geo: &[TriangleGeometry],
+        stats: &mut SolveStats,
+    ) -> Result<StaticResult, FeError> {
+        let t1 = Instant::now();
+        let n = self.dofs.n_free();
+        let el = &*self.element;
+        let alpha = model.drilling_alpha;
         let mut u = Mat::<f64>::zeros(n, 1);
         for (i, &g) in self.dofs.free.iter().enumerate() {
             u[(i, 0)] = f[g];
@@ -321,7 +345,7 @@ impl BucklingSolver {
         for (i, &g) in self.dofs.free.iter().enumerate() {
             disp[g / 6][g % 6] = u[(i, 0)];
         }
-        stats.t_factor = t1.elapsed().as_secs_f64();
+        stats.t_factor += t1.elapsed().as_secs_f64();
 
         let t2 = Instant::now();
         let elements: Vec<ElementResult> = {
@@ -378,20 +402,15 @@ impl BucklingSolver {
             .iter()
             .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
             .fold(0.0, f64::max);
-        stats.t_geometric = t2.elapsed().as_secs_f64();
-        Ok(StaticInternal {
-            result: StaticResult {
-                displacements: disp,
-                elements,
-                reactions,
-                reactions_sum,
-                load_sum,
-                max_displacement,
-                n_free_dofs: n,
-            },
-            llt,
-            kvals,
-            geo,
+        stats.t_geometric += t2.elapsed().as_secs_f64();
+        Ok(StaticResult {
+            displacements: disp,
+            elements,
+            reactions,
+            reactions_sum,
+            load_sum,
+            max_displacement,
+            n_free_dofs: n,
         })
     }
 
@@ -482,6 +501,44 @@ impl BucklingSolver {
         model: &ShellModel,
         options: &BucklingOptions,
     ) -> Result<BucklingResult, FeError> {
+        self.buckling_cases(model, options, None).map(|(r, _)| r)
+    }
+
+    /// [`BucklingSolver::buckling`] and a second load case solved with the same factor of K:
+    /// the self-weight of the triangles `e` with `weight[e]` alone (plus `model`'s nodal loads).
+    /// The result is exactly [`BucklingSolver::linear_static`] of `model` with the other
+    /// triangles' unit weight set to zero (K does not depend on the unit weight), for one
+    /// triangular solve instead of a second factorization: e.g. the weight a print state adds,
+    /// whose static increment the as-printed shape sums (docs/as-printed.md).
+    ///
+    /// # Errors
+    /// As [`BucklingSolver::buckling`]; `weight` must have one entry per triangle.
+    pub fn buckling_with_weight_case(
+        &self,
+        model: &ShellModel,
+        options: &BucklingOptions,
+        weight: &[bool],
+    ) -> Result<(BucklingResult, StaticResult), FeError> {
+        if weight.len() != model.triangles.len() {
+            return Err(FeError::BadOption {
+                field: "weight (one entry per triangle)",
+                value: weight.len() as f64,
+                allowed: "as many entries as the model has triangles",
+            });
+        }
+        let (r, case) = self.buckling_cases(model, options, Some(weight))?;
+        case.map(|c| (r, c)).ok_or(FeError::Numerical {
+            stage: "weight case",
+            detail: "the second load case was not solved".into(),
+        })
+    }
+
+    fn buckling_cases(
+        &self,
+        model: &ShellModel,
+        options: &BucklingOptions,
+        weight: Option<&[bool]>,
+    ) -> Result<(BucklingResult, Option<StaticResult>), FeError> {
         self.check(model)?;
         if options.modes == 0 {
             return Err(FeError::BadOption {
@@ -510,6 +567,23 @@ impl BucklingSolver {
             kvals,
             geo,
         } = self.static_internal(model, &mut stats)?;
+        let case = match weight {
+            Some(w) => {
+                let mut only = model.clone();
+                only.materials = (0..model.triangles.len())
+                    .map(|e| {
+                        let mut m = model.material_of(e);
+                        if !w[e] {
+                            m.unit_weight = 0.0;
+                        }
+                        m
+                    })
+                    .collect();
+                let f = load_vector(&only, &geo);
+                Some(self.static_solve(&only, &llt, &f, &geo, &mut stats)?)
+            }
+            None => None,
+        };
         let t0 = Instant::now();
         let el = &*self.element;
         let elements = &static_result.elements;
@@ -639,14 +713,17 @@ impl BucklingSolver {
             }
             modes.push(shape);
         }
-        Ok(BucklingResult {
-            factors,
-            modes,
-            residuals,
-            sturm,
-            static_result,
-            stats,
-        })
+        Ok((
+            BucklingResult {
+                factors,
+                modes,
+                residuals,
+                sturm,
+                static_result,
+                stats,
+            },
+            case,
+        ))
     }
 
     /// Sturm count at σ (perturbed slightly if a pivot is exactly zero).

@@ -289,3 +289,43 @@ fn types_are_send_and_sync() {
     check::<kappe_fe::BucklingResult>();
     check::<kappe_fe::FeError>();
 }
+
+/// The second load case of `buckling_with_weight_case` (the self-weight of some triangles
+/// alone, solved with the buckling solve's factor of K) is the linear static solution of the
+/// model with the other triangles' unit weight zeroed: the same K, pattern, ordering and
+/// right-hand side, so the same bits. Its own buckling result is the plain solve's. A weight
+/// mask of the wrong length is a named error.
+#[test]
+fn the_weight_case_is_the_static_solution_of_that_weight_alone() {
+    let m = kappe_fe::generate::barrel_vault(10, 6);
+    let n_el = m.triangles.len();
+    // The half of the elements with the larger index: a load that is not a multiple of the
+    // whole self-weight, so a solve of the wrong right-hand side cannot pass.
+    let mask: Vec<bool> = (0..n_el).map(|e| e >= n_el / 2).collect();
+    let solver = BucklingSolver::new(&m).unwrap();
+    let (r, case) = solver
+        .buckling_with_weight_case(&m, &fast(1), &mask)
+        .unwrap();
+    let mut only = m.clone();
+    only.materials = (0..n_el)
+        .map(|e| {
+            let mut mat = m.material_of(e);
+            if !mask[e] {
+                mat.unit_weight = 0.0;
+            }
+            mat
+        })
+        .collect();
+    let own = kappe_fe::linear_static(&only).unwrap();
+    assert_eq!(case, own);
+    let plain = solver.buckling(&m, &fast(1)).unwrap();
+    assert_eq!(r.factors, plain.factors);
+    assert_eq!(r.static_result, plain.static_result);
+    // Not the whole weight's solution: about half the load.
+    let ratio = case.load_sum[2] / r.static_result.load_sum[2];
+    assert!(ratio > 0.3 && ratio < 0.7, "{ratio}");
+    assert!(matches!(
+        solver.buckling_with_weight_case(&m, &fast(1), &mask[1..]),
+        Err(kappe_fe::FeError::BadOption { .. })
+    ));
+}

@@ -89,19 +89,33 @@ pub struct AsPrinted {
 /// # Errors
 /// The static solve fails (e.g. the model is a mechanism).
 pub fn increment(model: &ShellModel, keys: &[Option<NodeKey>]) -> Result<Increment, FeError> {
-    let r = kappe_fe::linear_static(model)?;
+    Ok(increment_of(
+        &model.nodes,
+        keys,
+        &kappe_fe::linear_static(model)?,
+    ))
+}
+
+/// The increment from the static solution `r` of a state's new weight on the model with nodes
+/// `nodes` (`keys` as in [`increment`]): e.g. the second load case of the state's buckling solve
+/// (`kappe_fe::BucklingSolver::buckling_with_weight_case`), which reuses its factor of K.
+pub fn increment_of(
+    nodes: &[[f64; 3]],
+    keys: &[Option<NodeKey>],
+    r: &kappe_fe::StaticResult,
+) -> Increment {
     let load = norm(r.load_sum);
     let sum = [0, 1, 2].map(|c| r.reactions_sum[c] + r.load_sum[c]);
     let nodes = keys
         .iter()
-        .zip(&model.nodes)
+        .zip(nodes)
         .zip(&r.displacements)
         .filter_map(|((k, x), d)| k.map(|k| (k, *x, [d[0], d[1], d[2]])))
         .collect();
-    Ok(Increment {
+    Increment {
         nodes,
         residual: if load > 0.0 { norm(sum) / load } else { 0.0 },
-    })
+    }
 }
 
 fn norm(v: [f64; 3]) -> f64 {
@@ -248,12 +262,42 @@ pub fn cap_as_printed(
     green: Option<&crate::analysis::green::CapGreen>,
     cancelled: &(dyn Fn() -> Result<(), DesignError> + Sync),
 ) -> Result<AsPrinted, DesignError> {
-    let increments = (0..cap.states.len())
+    cap_as_printed_given(cap, options, green, HashMap::new(), cancelled)
+}
+
+/// [`cap_as_printed`] with the increments of some states already solved (`known`, by state
+/// index: the buckling pass solves a state's increment inside its own factorization of K,
+/// `crate::analysis::check`); only the others are solved here ([`cap_increment`]). A known
+/// increment must be [`cap_increment`]'s of the same state, options and `green`.
+///
+/// # Errors
+/// As [`cap_as_printed`].
+pub fn cap_as_printed_given(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    mut known: HashMap<usize, Increment>,
+    cancelled: &(dyn Fn() -> Result<(), DesignError> + Sync),
+) -> Result<AsPrinted, DesignError> {
+    let todo: Vec<usize> = (0..cap.states.len())
+        .filter(|top| !known.contains_key(top))
+        .collect();
+    let solved = todo
         .into_par_iter()
         .map(|top| {
             cancelled()?;
-            cap_increment(cap, options, green, top)
+            cap_increment(cap, options, green, top).map(|i| (top, i))
         })
         .collect::<Result<Vec<_>, DesignError>>()?;
+    known.extend(solved);
+    let increments: Vec<Increment> = (0..cap.states.len())
+        .map(|top| known.remove(&top).unwrap_or_default())
+        .collect();
     Ok(accumulate(&increments))
+}
+
+/// Whether the buckling pass's print-layer mesh of a state is the as-printed pass's own mesh
+/// (every layer a row, no grading), so its factor of K can solve the state's increment.
+pub fn shares_mesh(options: &AnalysisOptions) -> bool {
+    options.row_stride <= 1 && options.grading.is_none()
 }

@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
+use crate::analysis::asprinted::Increment;
 use crate::analysis::shell::{NoShell, ShellMaterial, StateShell, state_shell};
 use crate::form::cap::Cap;
 use crate::form::states::State;
@@ -146,6 +147,22 @@ pub fn state_buckling_warm(
     options: &AnalysisOptions,
     guess: Option<&ModeGuess>,
 ) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
+    state_buckling_printed(state, material, options, guess, false).map(|(b, m, g, _)| (b, m, g))
+}
+
+/// [`state_buckling_warm`] and, with `printed` on a mesh the as-printed pass shares
+/// ([`crate::analysis::asprinted::shares_mesh`]), the state's as-printed increment (the weight
+/// of its new strip alone) solved with the buckling solve's own factor of K: exactly
+/// [`crate::analysis::asprinted::cap_increment`]'s, for one triangular solve instead of a
+/// second factorization. `None` without `printed`, on a mesh the pass does not share, for a
+/// single layer or a mechanism.
+pub fn state_buckling_printed(
+    state: &State,
+    material: &ShellMaterial,
+    options: &AnalysisOptions,
+    guess: Option<&ModeGuess>,
+    printed: bool,
+) -> Result<(StateBuckling, NetworkMode, ModeGuess, Option<Increment>), DesignError> {
     // A graded mesh (issue 15, `crate::analysis::graded`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
     let analysed = crate::analysis::graded::AnalysedState::new(state, options.grading.as_ref());
@@ -163,6 +180,7 @@ pub fn state_buckling_warm(
                 },
                 Vec::new(),
                 ModeGuess::new(),
+                None,
             ));
         }
     };
@@ -170,7 +188,25 @@ pub fn state_buckling_warm(
     let start = guess
         .filter(|g| !g.is_empty())
         .map(|g| guess_start(&keys, g));
-    let (b, mode, full, _) = shell_buckling_run(&shell, state.index, options, start)?;
+    // The as-printed increment's load: the strip that ends in the new top layer
+    // (`asprinted::cap_increment`).
+    let new_strip: Option<Vec<bool>> =
+        (printed && crate::analysis::asprinted::shares_mesh(options)).then(|| {
+            shell
+                .element_layers
+                .iter()
+                .map(|l| l.1 == state.top_layer)
+                .collect()
+        });
+    let Run {
+        buckling: b,
+        mode,
+        full,
+        case,
+        ..
+    } = shell_buckling_run(&shell, state.index, options, start, new_strip.as_deref())?;
+    let increment =
+        case.map(|r| crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r));
     let mode = mode
         .into_iter()
         .map(|(k, d)| (analysed.full_index(k).unwrap_or(k), d))
@@ -183,7 +219,7 @@ pub fn state_buckling_warm(
                 .collect()
         })
         .unwrap_or_default();
-    Ok((b, mode, next))
+    Ok((b, mode, next, increment))
 }
 
 /// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
@@ -214,30 +250,42 @@ pub fn shell_buckling_full(
     state: usize,
     options: &AnalysisOptions,
 ) -> Result<(StateBuckling, NetworkMode, Option<kappe_fe::StaticResult>), DesignError> {
-    shell_buckling_run(shell, state, options, None).map(|(b, m, _, s)| (b, m, s))
+    shell_buckling_run(shell, state, options, None, None)
+        .map(|r| (r.buckling, r.mode, r.static_result))
+}
+
+/// What [`shell_buckling_run`] returns.
+struct Run {
+    buckling: StateBuckling,
+    mode: NetworkMode,
+    /// Mode 1 with all six freedoms per shell node.
+    full: Option<Vec<[f64; 6]>>,
+    /// The static solution the buckling solve started from (None for a mechanism).
+    static_result: Option<kappe_fe::StaticResult>,
+    /// The second load case (the `weight` triangles' self-weight alone), if asked for.
+    case: Option<kappe_fe::StaticResult>,
 }
 
 /// One buckling solve of a shell model, started from `start` (per shell node) if given; also
-/// returns mode 1 with all six freedoms per shell node.
-#[allow(clippy::type_complexity)]
+/// returns mode 1 with all six freedoms per shell node and, with `weight` (per triangle), the
+/// static solution under those triangles' self-weight alone, on the same factor of K.
 fn shell_buckling_run(
     shell: &StateShell,
     state: usize,
     options: &AnalysisOptions,
     start: Option<Vec<[f64; 6]>>,
-) -> Result<
-    (
-        StateBuckling,
-        NetworkMode,
-        Option<Vec<[f64; 6]>>,
-        Option<kappe_fe::StaticResult>,
-    ),
-    DesignError,
-> {
+    weight: Option<&[bool]>,
+) -> Result<Run, DesignError> {
     let fe_opts = fe_options(options, start);
     let n = shell.model.nodes.len();
-    match kappe_fe::buckling(&shell.model, &fe_opts) {
-        Ok(r) => {
+    let solved = match weight {
+        Some(w) => kappe_fe::BucklingSolver::new(&shell.model)
+            .and_then(|s| s.buckling_with_weight_case(&shell.model, &fe_opts, w))
+            .map(|(r, c)| (r, Some(c))),
+        None => kappe_fe::buckling(&shell.model, &fe_opts).map(|r| (r, None)),
+    };
+    match solved {
+        Ok((r, case)) => {
             let static_result = Some(r.static_result.clone());
             let location = r.modes.first().and_then(|m| {
                 let (i, _) = m
@@ -274,8 +322,8 @@ fn shell_buckling_run(
                 None
             };
             let full = r.modes.into_iter().next();
-            Ok((
-                StateBuckling {
+            Ok(Run {
+                buckling: StateBuckling {
                     status: if r.factors.is_empty() {
                         BucklingStatus::NoPositiveFactor
                     } else {
@@ -290,7 +338,8 @@ fn shell_buckling_run(
                 mode,
                 full,
                 static_result,
-            ))
+                case,
+            })
         }
         Err(kappe_fe::FeError::Mechanism { free_dofs }) => {
             let mut layers: Vec<i32> = free_dofs
@@ -306,8 +355,8 @@ fn shell_buckling_run(
             layers.sort_unstable();
             layers.dedup();
             let dofs: Vec<String> = free_dofs.iter().take(6).map(|d| d.to_string()).collect();
-            Ok((
-                StateBuckling {
+            Ok(Run {
+                buckling: StateBuckling {
                     status: BucklingStatus::Mechanism,
                     factors: Vec::new(),
                     location: first,
@@ -318,10 +367,11 @@ fn shell_buckling_run(
                     shell_nodes: n,
                     convergence: None,
                 },
-                Vec::new(),
-                None,
-                None,
-            ))
+                mode: Vec::new(),
+                full: None,
+                static_result: None,
+                case: None,
+            })
         }
         Err(e) => Err(DesignError::State {
             state,

@@ -7,8 +7,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::asprinted::Increment;
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_warm, state_material_with,
+    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_printed,
+    state_material_with,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -357,13 +359,26 @@ pub fn state_fe(
     top: usize,
     guess: &mut Option<ModeGuess>,
 ) -> Result<StateFe, DesignError> {
+    state_fe_first(cap, options, green, top, guess, false).map(|(f, _)| f)
+}
+
+/// [`state_fe`] and, with `printed`, the state's as-printed increment solved inside its
+/// buckling solve (`state_buckling_printed`; `None` where that solve cannot give it).
+fn state_fe_first(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    guess: &mut Option<ModeGuess>,
+    printed: bool,
+) -> Result<(StateFe, Option<Increment>), DesignError> {
     // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
     // all states together ([`converge_fe`]).
     let first = AnalysisOptions {
         blf_max_split: 1,
         ..options.clone()
     };
-    state_fe_with(cap, &first, green, top, guess)
+    state_fe_printed(cap, &first, green, top, guess, printed)
 }
 
 /// [`state_fe`] with the options as given (`blf_max_split` > 1: the split meshes too).
@@ -374,6 +389,18 @@ fn state_fe_with(
     top: usize,
     guess: &mut Option<ModeGuess>,
 ) -> Result<StateFe, DesignError> {
+    state_fe_printed(cap, options, green, top, guess, false).map(|(f, _)| f)
+}
+
+/// [`state_fe_with`] and, with `printed`, the as-printed increment of [`state_fe_first`].
+fn state_fe_printed(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    guess: &mut Option<ModeGuess>,
+    printed: bool,
+) -> Result<(StateFe, Option<Increment>), DesignError> {
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
@@ -384,21 +411,25 @@ fn state_fe_with(
         Some(g) => g.state_checks(&state, &mat, options, top)?,
         None => None,
     };
-    let (buckling, mode, green) = match checked {
-        Some(c) => c,
+    let (buckling, mode, green, increment) = match checked {
+        Some((b, mode, green)) => (b, mode, green, None),
         _ => {
-            let (b, mode, next) = state_buckling_warm(&state, &mat, options, guess.as_ref())?;
+            let (b, mode, next, increment) =
+                state_buckling_printed(&state, &mat, options, guess.as_ref(), printed)?;
             *guess = Some(next);
-            (b, mode, None)
+            (b, mode, None, increment)
         }
     };
-    Ok(StateFe {
-        state: top,
-        buckling,
-        mode,
-        green,
-        seconds: t0.elapsed().as_secs_f64(),
-    })
+    Ok((
+        StateFe {
+            state: top,
+            buckling,
+            mode,
+            green,
+            seconds: t0.elapsed().as_secs_f64(),
+        },
+        increment,
+    ))
 }
 
 /// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
@@ -620,6 +651,7 @@ fn analyze_from_fe(
         &interpolated,
         (t_all, 0.0),
         complete,
+        Default::default(),
         context.stop_flag(),
     )
 }
@@ -657,6 +689,9 @@ fn analyze_all(
     // Each state's first-pass mode is kept (about 50 bytes a shell node) so the mesh-error pass
     // continues from it instead of solving the print-layer mesh again (`state_refine`).
     let first_modes = std::sync::Mutex::new(std::collections::HashMap::new());
+    // Each state's as-printed increment, solved inside its buckling solve's factorization of K
+    // (the as-printed pass then factorizes only the states this pass did not solve).
+    let increments = std::sync::Mutex::new(std::collections::HashMap::new());
     let fe: Vec<StateFe> = runs
         .into_par_iter()
         .map(|run| {
@@ -664,7 +699,13 @@ fn analyze_all(
             let mut out = Vec::with_capacity(run.len());
             for top in run {
                 cancelled()?;
-                let f = state_fe(cap, options, green.as_ref(), top, &mut guess)?;
+                let (f, increment) =
+                    state_fe_first(cap, options, green.as_ref(), top, &mut guess, true)?;
+                if let Some(i) = increment
+                    && let Ok(mut m) = increments.lock()
+                {
+                    m.insert(top, i);
+                }
                 if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first())
                     && let Ok(mut m) = first_modes.lock()
                 {
@@ -714,6 +755,7 @@ fn analyze_all(
         &interpolated,
         (t_all, wall_fe),
         true,
+        increments.into_inner().unwrap_or_default(),
         stop,
     )
 }
@@ -722,7 +764,8 @@ fn analyze_all(
 /// the finite-element results `fe`; `clock`: when the analysis started and the wall-clock
 /// seconds of the finite-element phase. `complete`: every selected state is in `fe`, so the
 /// whole-print passes run (the as-printed shape; a partial verdict, the designer's while its
-/// workers run, leaves them out rather than pay for them at every result).
+/// workers run, leaves them out rather than pay for them at every result). `increments`: the
+/// as-printed increments the buckling solves already gave (by state; the pass solves the rest).
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     cap: &Cap,
@@ -732,6 +775,7 @@ fn assemble(
     interpolated: &[usize],
     (t_all, wall_fe): (Instant, f64),
     complete: bool,
+    increments: std::collections::HashMap<usize, Increment>,
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     let cancelled = || {
@@ -1012,8 +1056,13 @@ fn assemble(
     let t_printed = Instant::now();
     let deviation_max = design.deviation_max();
     let as_printed = if options.buckling && total > 0 && complete {
-        let a =
-            crate::analysis::asprinted::cap_as_printed(cap, options, green.as_ref(), &cancelled)?;
+        let a = crate::analysis::asprinted::cap_as_printed_given(
+            cap,
+            options,
+            green.as_ref(),
+            increments,
+            &cancelled,
+        )?;
         for (s, d) in states.iter_mut().zip(&a.states) {
             s.ok &= d.deviation_m <= deviation_max;
         }

@@ -51,7 +51,7 @@ pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, ana
 pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
-pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment};
+pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
 pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
 pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};

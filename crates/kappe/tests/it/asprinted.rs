@@ -228,6 +228,41 @@ fn the_cap_as_printed_pass_reports_every_state() {
     );
 }
 
+/// The analysis solves each buckled state's as-printed increment inside its buckling solve's
+/// factorization of K (`state_buckling_printed`) instead of factorizing K again; the pass must
+/// be exactly the stand-alone one (`cap_as_printed`: every increment its own linear static
+/// solve), bit for bit, on the full print-layer mesh and on a graded one (whose states the pass
+/// still solves itself).
+#[test]
+fn the_buckling_solves_give_the_as_printed_increments_exactly() {
+    let design = kappe::Design::from_toml_str("[cap]\nlength = 0.2\n").expect("design");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
+    let mut options = design.analysis.clone();
+    // The first pass only: the mesh-error pass does not touch the increments.
+    options.converged_blf = false;
+    assert!(kappe::analysis::shares_mesh(&options));
+    let alone =
+        kappe::analysis::cap_as_printed(&cap, &options, None, &|| Ok(())).expect("as-printed");
+    let a = kappe::analysis::analyze(&cap, &options, kappe::analysis::Request::default())
+        .expect("analysis");
+    assert_eq!(a.as_printed.as_ref(), Some(&alone));
+    // Every state was buckled, so every increment but the bed layer's came from a buckling
+    // solve (the test would pass vacuously if none did).
+    let buckled = a
+        .states
+        .iter()
+        .filter(|s| s.buckling == kappe::analysis::BucklingStatus::Analysed)
+        .count();
+    assert!(buckled + 1 >= cap.states.len(), "{buckled} buckled");
+    // Grading thins the rows: the buckling mesh is not the pass's, which solves every state.
+    let mut graded = options.clone();
+    graded.row_stride = 2;
+    assert!(!kappe::analysis::shares_mesh(&graded));
+    let g = kappe::analysis::analyze(&cap, &graded, kappe::analysis::Request::default())
+        .expect("graded analysis");
+    assert_eq!(g.as_printed.as_ref(), Some(&alone));
+}
+
 #[test]
 fn a_deviation_above_deviation_max_fails_the_design_with_its_levers() {
     // 1 µm is far below the short cap's sag (≈ 1 mm on the default cap): the row must fail,

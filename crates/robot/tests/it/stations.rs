@@ -220,4 +220,3 @@ fn schedule_of_a_two_station_plan() {
             .contains("speed")
     );
 }
-
