@@ -61,3 +61,80 @@ fn design_runs_a_three_bay_ceiling() {
         bays.iter().all(|b| b["ok"] == serde_json::json!(true))
     );
 }
+
+/// Issue 27: a ceiling with `[robot.base] mode = "moving"` prints each half of a bay in one take
+/// with the base moving: both halves get the moving plan's files, and the mirrored half's base
+/// creeps toward −y (its front advances that way) while the first half's creeps toward +y.
+#[test]
+fn moving_base_ceiling_plans_each_half_moving() {
+    let tmp = tempfile::tempdir().unwrap();
+    // One default-size bay (0.8 m span, as the moving default cap) between walls 1 m apart.
+    let room = "name = \"moving room\"\n[ceiling]\nlength = 1.0\nends = \"both_walls\"\n\
+                rise_ratio = 0.25\n[[bay]]\nspan = 0.8\n[robot.base]\nmode = \"moving\"\n";
+    std::fs::write(tmp.path().join("room.toml"), room).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_kappe"))
+        .current_dir(tmp.path())
+        .args([
+            "design",
+            "room.toml",
+            "--out",
+            "room",
+            "--quiet",
+            "--no-buckling",
+            "--allow-fail",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let bay = tmp.path().join("room/bay_1");
+    let base_y = |p: &std::path::Path| -> Vec<f64> {
+        let text = std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        let mut lines = text.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let c = head.iter().position(|h| *h == "base_y").unwrap();
+        lines
+            .map(|l| l.split(',').nth(c).unwrap().parse().unwrap())
+            .collect()
+    };
+    let first = base_y(&bay.join("base_trajectory.csv"));
+    let mirror = base_y(&bay.join("mirror/base_trajectory.csv"));
+    // The base travels a few centimetres at least (the centre sections are ≈ 0.36 m long); 1 cm
+    // separates a creeping base from one standing still.
+    let travel = |v: &[f64]| v.last().unwrap() - v.first().unwrap();
+    assert!(travel(&first) > 0.01, "first half: {}", travel(&first));
+    assert!(travel(&mirror) < -0.01, "mirror: {}", travel(&mirror));
+    for half in ["", "mirror/"] {
+        let head = std::fs::read_to_string(bay.join(format!("{half}trajectory.csv"))).unwrap();
+        assert!(
+            head.lines()
+                .next()
+                .unwrap()
+                .ends_with("base_x,base_y,base_yaw"),
+            "{half}trajectory.csv"
+        );
+        let prog = std::fs::read_to_string(bay.join(format!("{half}program_part01.script")))
+            .unwrap_or_else(|e| panic!("{half}program_part01.script: {e}"));
+        assert!(prog.contains("track_conveyor_linear"), "{half}");
+        // The tracking form passes `kappe robot lint` (issue 27 verification).
+        let lint = Command::new(env!("CARGO_BIN_EXE_kappe"))
+            .current_dir(&bay)
+            .args(["robot", "lint", &format!("{half}program_part01.script")])
+            .output()
+            .unwrap();
+        assert!(
+            lint.status.success(),
+            "{}",
+            String::from_utf8_lossy(&lint.stdout)
+        );
+    }
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(tmp.path().join("room/ceiling.json")).unwrap())
+            .unwrap();
+    // One take per half: one "station" each, no relocation.
+    assert_eq!(summary["bays"][0]["robot"]["stations"], 2);
+}

@@ -40,7 +40,7 @@ use crate::analysis::AnalysisOptions;
 use crate::form::ends::EndKind;
 use crate::input::design::{ConstraintSpec, Design, MaterialSpec, PrintSpec, RobotSpec};
 use crate::input::error::DesignError;
-use crate::output::{OutputError, OutputFile, plan_files};
+use crate::output::{OutputError, OutputFile, moving_plan_files, plan_files};
 use crate::run::{Options, Outcome, Progress};
 
 /// The commented example ceiling that `kappe init --kind ceiling` writes: three bays of 1.2 m
@@ -258,6 +258,9 @@ pub struct BayOutcome {
     pub mirror_plan: Option<Result<kappe_robot::Plan, kappe_robot::RobotError>>,
     /// The base-pose tolerance check of the mirrored half's plan (`[robot.tolerance]`).
     pub mirror_tolerance: Option<kappe_robot::tolerance::ToleranceReport>,
+    /// With a moving base (`[robot.base] mode = "moving"`, issue 27), the mirrored half's moving
+    /// plan; `mirror_plan` then holds its arm plan (as `Outcome::robot` does for the first half).
+    pub mirror_moving: Option<kappe_robot::MovingPlan>,
 }
 
 /// The whole ceiling.
@@ -322,11 +325,38 @@ pub fn run_bay(
     } else {
         1
     };
-    let mirror_plan =
-        (halves == 2 && options.robot && d.robot.enabled).then(|| plan_mirrored(&outcome.cap));
+    let mirrored = halves == 2 && options.robot && d.robot.enabled;
+    let (mirror_plan, mirror_moving) = match (&d.robot.base, mirrored) {
+        (_, false) => (None, None),
+        (kappe_robot::BaseMode::Stations, true) => (Some(plan_mirrored(&outcome.cap)), None),
+        // The second half on the first half's clock: its layers wait what the first half's do.
+        (kappe_robot::BaseMode::Moving(base), true) => {
+            let waits: Option<Vec<kappe_robot::LayerWait>> = outcome
+                .robot
+                .as_ref()
+                .and_then(|p| p.as_ref().ok())
+                .map(|p| {
+                    kappe_robot::layer_times(p)
+                        .iter()
+                        .map(|t| kappe_robot::LayerWait {
+                            layer: t.layer,
+                            wait: t.wait,
+                        })
+                        .collect()
+                });
+            match plan_mirrored_moving(&outcome.cap, base, waits.as_deref()) {
+                Ok(mp) => (Some(Ok(mp.plan.clone())), Some(mp)),
+                Err(e) => (Some(Err(e)), None),
+            }
+        }
+    };
     let tol = &d.robot.tolerance;
-    let mirror_tolerance = match &mirror_plan {
-        Some(Ok(plan)) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
+    let mirror_tolerance = match (&mirror_plan, &mirror_moving) {
+        (Some(Ok(_)), Some(mp)) if tol.check => Some(kappe_robot::check_moving_tolerance(
+            mp,
+            &tol.base_tolerance(),
+        )),
+        (Some(Ok(plan)), None) if tol.check => Some(kappe_robot::tolerance::check_base_tolerance(
             plan,
             &tol.base_tolerance(),
         )),
@@ -339,6 +369,7 @@ pub fn run_bay(
         outcome,
         mirror_plan,
         mirror_tolerance,
+        mirror_moving,
     })
 }
 
@@ -365,6 +396,30 @@ impl CeilingOutcome {
 pub fn plan_mirrored(
     cap: &crate::form::cap::Cap,
 ) -> Result<kappe_robot::Plan, kappe_robot::RobotError> {
+    let (layers, setup, opts) = mirrored_inputs(cap);
+    kappe_robot::plan_print(&layers, &setup, &opts)
+}
+
+/// [`plan_mirrored`] with the base moving while it prints (issue 27): `kappe_robot::plan_moving`
+/// on the mirrored layers and cell. The moving planner takes the front advancing toward −y
+/// itself (the base's along-bay position and heading reflected, `kappe_robot::moving`).
+pub fn plan_mirrored_moving(
+    cap: &crate::form::cap::Cap,
+    base: &kappe_robot::MovingBase,
+    waits: Option<&[kappe_robot::LayerWait]>,
+) -> Result<kappe_robot::MovingPlan, kappe_robot::RobotError> {
+    let (layers, setup, opts) = mirrored_inputs(cap);
+    kappe_robot::plan_moving(&layers, &setup, &opts, base, waits)
+}
+
+/// The layers, cell and options of a cap's print mirrored y → −y.
+fn mirrored_inputs(
+    cap: &crate::form::cap::Cap,
+) -> (
+    Vec<kappe_robot::setup::PrintLayer>,
+    kappe_robot::setup::RobotSetup,
+    kappe_robot::setup::PlanOptions,
+) {
     use kappe_robot::setup::BasePlacement;
     let (mut setup, opts) = crate::robot_plan::robot_inputs(cap);
     let mut layers = crate::robot_plan::print_layers(&cap.path);
@@ -407,7 +462,7 @@ pub fn plan_mirrored(
                 .to_mat4();
         }
     }
-    kappe_robot::plan_print(&layers, &setup, &opts)
+    (layers, setup, opts)
 }
 
 impl BayOutcome {
@@ -688,12 +743,22 @@ impl BayOutcome {
                         kappe_robot::stations::station_sheet(plan, tol, Ok("program_part")),
                     )
                 };
-            if let Some(Ok(plan)) = &eval.robot {
-                let plan = eval.marked_plan(plan);
-                out.extend(plan_files(&plan, "program_part", true)?);
-                out.push(sheet(&plan, eval.base_tolerance.as_ref()));
+            // A moving base: each half's tracking programs and base trajectory (issue 27).
+            match (&eval.robot, &eval.moving) {
+                (Some(Ok(_)), Some(m)) => {
+                    out.extend(moving_plan_files(&m.plan, "program_part", true)?);
+                }
+                (Some(Ok(plan)), None) => {
+                    let plan = eval.marked_plan(plan);
+                    out.extend(plan_files(&plan, "program_part", true)?);
+                    out.push(sheet(&plan, eval.base_tolerance.as_ref()));
+                }
+                _ => {}
             }
-            if let Some(Ok(plan)) = &self.mirror_plan {
+            if let Some(mp) = &self.mirror_moving {
+                let files = moving_plan_files(mp, "program_part", true)?;
+                out.extend(files.into_iter().map(|f| f.under("mirror")));
+            } else if let Some(Ok(plan)) = &self.mirror_plan {
                 let plan = eval.marked_plan(plan);
                 let mut files = plan_files(&plan, "program_part", true)?;
                 files.push(sheet(&plan, self.mirror_tolerance.as_ref()));

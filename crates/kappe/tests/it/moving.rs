@@ -75,6 +75,51 @@ fn moving_base_default_cap_end_to_end() {
     let m = out.moving.as_ref().expect("a moving plan");
     assert!(m.tracking.is_ok(), "{:?}", m.tracking);
     assert!((out.print_time() - plan.total_time).abs() < 1e-9);
+    // The schedule (and so every layer's age in the analysis) is the moving plan's clock, and
+    // it has no station pause: each gap between layers is the wait plus the layer change, and
+    // the change is a move of a few centimetres at printing speed, ≪ the 60 s a station's
+    // drive and re-localisation add (`[robot.plan] station_change_time`). The station plan of
+    // the same cap does pause: its largest gap is at least that long.
+    assert_eq!(out.schedule.source, kappe::schedule::TimeSource::RobotPlan);
+    let times = kappe_robot::layer_times(plan);
+    assert_eq!(out.schedule.layers.len(), times.len());
+    for (s, t) in out.schedule.layers.iter().zip(&times) {
+        assert!((s.start_s - t.start).abs() < 1e-9 && (s.end_s - t.end).abs() < 1e-9);
+    }
+    let gap =
+        |s: &kappe::schedule::Schedule| s.layers.iter().map(|l| l.relocation_s).fold(0.0, f64::max);
+    let moving_gap = gap(&out.schedule);
+    // The largest gap a moving plan may have: a program change (switch time, then the pump
+    // primed again) and 5 s of layer change (≤ 0.25 m, the default cap's foot-to-foot hop plus
+    // approach, at the 0.05 m/s print speed); a station change adds 60 s more.
+    let o = &plan.options;
+    let allowed = o.program.program_switch_time + o.pump.prime_dwell + 5.0;
+    assert!(
+        allowed < o.station_change_time && moving_gap <= allowed,
+        "a pause of {moving_gap} s in the moving schedule (allowed {allowed} s)"
+    );
+    let n = out.schedule.layers.len();
+    let ages = out.schedule.ages(n);
+    for k in 0..n - 1 {
+        // Consecutive layers' ages differ by the upper layer's duration and the gap below it.
+        let step = ages[k] - ages[k + 1];
+        let dur = out.schedule.layers[k + 1].end_s - out.schedule.layers[k + 1].start_s;
+        let wait = out.schedule.layers[k].wait_s;
+        assert!(
+            step <= dur + wait + allowed + 1e-9,
+            "layer {k}: age step {step} s"
+        );
+    }
+    let station = kappe::robot_plan::plan_robot(&out.cap).unwrap();
+    let station_schedule =
+        kappe::schedule::from_robot(&kappe_robot::layer_times(&station)).unwrap();
+    if station.stations.len() > 1 {
+        assert!(
+            gap(&station_schedule) >= station.options.station_change_time - 1e-9,
+            "the station plan pauses at its seams: {} s",
+            gap(&station_schedule)
+        );
+    }
 
     let files = out.files().unwrap();
     let get = |name: &str| {
@@ -191,4 +236,64 @@ fn moving_base_limits_are_validated_by_name() {
     );
     let d = Design::from_toml_str("[robot.base]\nmode = \"stations\"\n").unwrap();
     assert_eq!(d.robot.base, kappe_robot::BaseMode::Stations);
+}
+
+/// The 1.5 m × 4 m bay of `kappe init --kind moving` (issue 27) form-finds: its final state's
+/// start layers have the factor d = φ = 0 by construction (method.md §6: the start section is
+/// shaped by that state's thrust line), so `d ≥ 0` sits on its bound. With 453 centre layers
+/// the thrust per unit weight is ≈ 211 and the round-off in d is ≈ 1e-11, which the old fixed
+/// 1e-12 refused ("layer −95: factor d = −0.0000 … cannot carry this state"). Here the final
+/// state builds and every start factor is φ to 1e-8 (the round-off bound of
+/// `form::states`, ≈ 1e-8 for this bay), and an intermediate state still has d in [0, 1].
+#[test]
+fn long_bay_start_section_final_state_builds() {
+    use kappe::form::arch::{ArchSpec, form_find_layer};
+    use kappe::form::frame::LayerFrame;
+    use kappe::form::section::build_sections;
+    use kappe::form::states::build_state;
+    let d = Design::from_toml_str(kappe::commands::templates::MOVING_TOML).unwrap();
+    assert_eq!((d.cap.span, d.cap.length), (1.5, 4.0), "the issue's bay");
+    let tilt = d.tilt();
+    let frame = LayerFrame::new(tilt);
+    let spec = ArchSpec {
+        span: d.cap.span,
+        rise: d.cap.rise,
+        tilt,
+        specific_weight: d.material.specific_weight,
+        layer_width: d.print.layer_width,
+        layer_height: d.print.layer_height,
+        path_sampling: d.print.path_sampling,
+    };
+    let arch = form_find_layer(&spec).unwrap();
+    let w = d.material.specific_weight * d.print.layer_width * d.print.layer_height;
+    let phi = d.print.start_arch_fraction;
+    assert_eq!(phi, 0.0, "the bound case: φ = 0");
+    let s = build_sections(
+        &arch,
+        &frame,
+        d.cap.length,
+        d.print.layer_height,
+        phi,
+        |c| 0.5 * c * w,
+    )
+    .unwrap();
+    assert!(
+        s.n_centre > 400 && s.n_start > 100,
+        "{} {}",
+        s.n_centre,
+        s.n_start
+    );
+    let last = s.layers.len() - 1;
+    let fin = build_state(&s, &frame, phi, last).unwrap();
+    let worst = fin.factors[..s.n_start]
+        .iter()
+        .map(|f| (f - phi).abs())
+        .fold(0.0, f64::max);
+    assert!(worst <= 1e-8, "start factors off φ by {worst:e}");
+    let mid = build_state(&s, &frame, phi, s.n_start + s.n_centre / 2).unwrap();
+    assert!(
+        mid.factors[..s.n_start]
+            .iter()
+            .all(|f| (-1e-8..=1.0 + 1e-8).contains(f))
+    );
 }
