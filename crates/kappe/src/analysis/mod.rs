@@ -29,6 +29,7 @@
 //! and [`check`] ([`analyze`]: every state against every constraint, and the report).
 
 pub mod asprinted;
+pub mod bending;
 pub mod blf_sensitivity;
 pub mod buckling;
 pub mod check;

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer, form_find_layer_with_segments};
 use crate::form::beads::{TriMesh, bead_mesh};
-use crate::form::forces::{Sections2D, StateForces, state_forces};
+use crate::form::forces::{Sections2D, StateForces, split_state_forces, state_forces};
 use crate::form::frame::LayerFrame;
 use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
@@ -206,12 +206,20 @@ pub(crate) fn design_cap_until(
     let phi = design.print.start_arch_fraction;
     let area = areas(design, &arch, &centre_arches);
     let total = sections.layers.len();
+    let corrugated = !centre_arches.is_empty();
     let solve = |top: usize| {
         if stop.load(Ordering::Relaxed) {
             return Err(DesignError::Cancelled);
         }
         let state = build_state(&sections, &frame, phi, top)?;
-        let (topology, pass, forces) = state_forces(&state, area)?;
+        // A corrugated state is not funicular for its loads: the network carries their
+        // funicular part exactly, the shell the rest (`split_state_forces`).
+        let (topology, pass, forces) = if corrugated {
+            let (t, p, f, _) = split_state_forces(&state, area)?;
+            (t, p, f)
+        } else {
+            state_forces(&state, area)?
+        };
         on_state(total);
         let summary = StateSummary {
             index: state.index,
