@@ -430,3 +430,72 @@ fn optimize_varies_the_corrugation() {
     // The result is `kappe design`'s verdict on it.
     assert_eq!(r.feasible, r.verdict.as_ref().is_some_and(|v| v.ok));
 }
+
+/// The robot prints a corrugated cap (issue 26, item 2): the planned targets are the layers'
+/// own (wavy) nozzle-tip points, every layer is one continuous bead at the print speed, and the
+/// programs pass the URScript check.
+#[test]
+fn the_nozzle_follows_the_waves() {
+    let d = Design::from_toml_str(&format!(
+        "[cap]\nlength = 0.2\n[print]\nlayer_height = 0.015\n[constraints]\noverhang_max = 0.05\n{WAVE}"
+    ))
+    .unwrap();
+    let cap = design_cap(&d, &|_| {}).unwrap();
+    let plan = kappe::robot_plan::plan_robot(&cap).unwrap();
+    let tips: std::collections::HashMap<(i64, usize), V3> = cap
+        .path
+        .points
+        .iter()
+        .map(|p| ((i64::from(p.layer), p.index), p.tip))
+        .collect();
+    // The wave is in the path: the crown tips of the centre layers do not lie on one line
+    // (a prism's would, every layer being layer 0 translated).
+    let crown_z: Vec<f64> = (0..cap.sections.n_centre as i64)
+        .filter_map(|k| {
+            cap.path
+                .points
+                .iter()
+                .filter(|p| i64::from(p.layer) == k)
+                .map(|p| p.tip.z)
+                .reduce(f64::max)
+        })
+        .collect();
+    let spread = crown_z.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - crown_z.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    assert!(spread > 0.02, "crown tips spread {spread} m");
+    let mut visited = 0;
+    for st in &plan.stations {
+        for l in &st.layers {
+            for (k, w) in l.waypoints.iter().enumerate() {
+                let tip = tips[&(l.layer, w.index)];
+                // The planner keeps the target it was given (copied, so exact; 1e-12 m allows
+                // an f32-free round trip through the plan's own arrays).
+                let err = (V3::from(w.position) - tip).norm();
+                assert!(
+                    err <= 1e-12,
+                    "layer {} point {}: target off by {err} m",
+                    l.layer,
+                    w.index
+                );
+                // Continuous flow: inside a layer every move prints, at the print speed unless
+                // the timing slowed it (then still > 0).
+                if k > 0 {
+                    if plan.slowdowns.is_empty() {
+                        let v = d.print.print_speed;
+                        assert!((w.speed - v).abs() <= 1e-9 * v, "speed {} m/s", w.speed);
+                    } else {
+                        assert!(w.speed > 0.0);
+                    }
+                }
+                visited += 1;
+            }
+        }
+    }
+    assert_eq!(
+        visited,
+        cap.path.points.len(),
+        "every path point is a target"
+    );
+    let files = kappe_robot::files::linted_programs(&plan, "corrugated").unwrap();
+    assert!(!files.is_empty());
+}
