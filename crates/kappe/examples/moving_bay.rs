@@ -47,7 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let load = load_average();
     let t = Instant::now();
-    let cap = kappe::design_cap(&design, &|_| {})?;
+    let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let t_form = t.elapsed().as_secs_f64();
     let (setup, opts) = kappe::robot_plan::robot_inputs(&cap);
     let layers = kappe::robot_plan::print_layers(&cap.path);

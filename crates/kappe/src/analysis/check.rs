@@ -100,6 +100,10 @@ pub struct StateAnalysis {
     /// empty when not analysed. Not in `summary.json`.
     #[serde(skip)]
     pub mode: super::buckling::NetworkMode,
+    /// A corrugated state: what its shell carries by bending (`crate::analysis::bending`);
+    /// `None` for a network in exact equilibrium under its own loads.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bending: Option<crate::analysis::bending::BendingSummary>,
 }
 
 /// One constraint of the report.
@@ -791,6 +795,7 @@ fn assemble(
     let phi = design.print.start_arch_fraction;
 
     struct PerState {
+        bending: Option<crate::analysis::bending::BendingSummary>,
         stresses: StressExtremes,
         stress_seconds: f64,
         buckling: Option<StateBuckling>,
@@ -804,7 +809,8 @@ fn assemble(
     // quadratic, in the bay length).
     let t_phase = Instant::now();
     let by_depth = match total.checked_sub(1) {
-        Some(last) if depth_invariant(&cap.sections) => {
+        // A corrugated cap's layers differ, so its forces are not a function of depth alone.
+        Some(last) if depth_invariant(&cap.sections) && cap.centre_arches.is_empty() => {
             let state = build_state(&cap.sections, &cap.frame, phi, last)?;
             extremes_by_depth(&cap.sections, &element_stresses(&state, areas)?)
         }
@@ -816,6 +822,7 @@ fn assemble(
             .into_iter()
             .enumerate()
             .map(|(top, stresses)| PerState {
+                bending: None,
                 stresses,
                 stress_seconds: secs,
                 buckling: None,
@@ -834,8 +841,22 @@ fn assemble(
                 let state = build_state(&cap.sections, &cap.frame, phi, top)?;
                 // Only the extremes are kept: all element stresses of every state would take memory
                 // quadratic in the bay length (0.7 GB for a 4 m bay).
-                let stresses = StressExtremes::of(&element_stresses(&state, areas)?);
+                let (stresses, bending) = if cap.centre_arches.is_empty() {
+                    (StressExtremes::of(&element_stresses(&state, areas)?), None)
+                } else {
+                    // The bending part of the corrugation (`crate::analysis::bending`).
+                    let mat = crate::analysis::buckling::state_material_with(
+                        cap,
+                        options,
+                        top,
+                        green.as_ref(),
+                    );
+                    let (all, bending) =
+                        crate::analysis::bending::corrugated_stresses(&state, areas, &mat)?;
+                    (StressExtremes::of(&all), bending)
+                };
                 Ok(PerState {
+                    bending,
                     stresses,
                     stress_seconds: t0.elapsed().as_secs_f64(),
                     buckling: None,
@@ -991,6 +1012,7 @@ fn assemble(
             collapse_mode: None,
             collapse_curve: Vec::new(),
             mode: p.mode.clone(),
+            bending: p.bending,
         });
     }
 

@@ -29,6 +29,7 @@
 //! and [`check`] ([`analyze`]: every state against every constraint, and the report).
 
 pub(crate) mod asprinted;
+pub(crate) mod bending;
 pub(crate) mod blf_sensitivity;
 pub(crate) mod buckling;
 pub(crate) mod check;
@@ -52,6 +53,7 @@ pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
+pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
 pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
 pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};

@@ -28,7 +28,7 @@ use crate::input::design::Design;
 use crate::input::error::DesignError;
 
 /// The parameters `kappe optimize` can vary, with their design-file names.
-pub const FREE_PARAMETERS: [&str; 7] = [
+pub const FREE_PARAMETERS: [&str; 9] = [
     "cap.span",
     "cap.rise",
     "cap.length",
@@ -36,6 +36,11 @@ pub const FREE_PARAMETERS: [&str; 7] = [
     "print.layer_height",
     "print.layer_width",
     "print.start_arch_fraction",
+    // Issue 26: the corrugation of the centre section (docs/corrugation.md). A design without
+    // `[cap.corrugation]` starts at amplitude 0 and the default wavelength; amplitude 0 is the
+    // smooth cap on exactly its code path, so the search can keep or drop the wave.
+    "cap.corrugation.amplitude",
+    "cap.corrugation.wavelength",
 ];
 
 /// Bounds of a free parameter (both required).
@@ -242,6 +247,8 @@ fn get(d: &Design, name: &str) -> f64 {
         "print.layer_height" => d.print.layer_height,
         "print.layer_width" => d.print.layer_width,
         "print.start_arch_fraction" => d.print.start_arch_fraction,
+        "cap.corrugation.amplitude" => d.cap.corrugation.as_ref().map_or(0.0, |c| c.amplitude),
+        "cap.corrugation.wavelength" => d.cap.corrugation.clone().unwrap_or_default().wavelength,
         _ => f64::NAN,
     }
 }
@@ -255,6 +262,18 @@ fn set(d: &mut Design, name: &str, v: f64) {
         "print.layer_height" => d.print.layer_height = v,
         "print.layer_width" => d.print.layer_width = v,
         "print.start_arch_fraction" => d.print.start_arch_fraction = v,
+        "cap.corrugation.amplitude" => {
+            d.cap
+                .corrugation
+                .get_or_insert_with(Default::default)
+                .amplitude = v;
+        }
+        "cap.corrugation.wavelength" => {
+            d.cap
+                .corrugation
+                .get_or_insert_with(Default::default)
+                .wavelength = v;
+        }
         _ => {}
     }
 }

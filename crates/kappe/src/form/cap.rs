@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer, form_find_layer_with_segments};
 use crate::form::beads::{TriMesh, bead_mesh};
-use crate::form::forces::{Sections2D, StateForces, state_forces};
+use crate::form::forces::{Sections2D, StateForces, split_state_forces, state_forces};
 use crate::form::frame::LayerFrame;
 use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
@@ -200,10 +200,18 @@ pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignEr
     let phi = design.print.start_arch_fraction;
     let area = areas(design, &arch, &centre_arches);
     let total = sections.layers.len();
+    let corrugated = !centre_arches.is_empty();
     let solve = |top: usize| {
         context.check()?;
         let state = build_state(&sections, &frame, phi, top)?;
-        let (topology, pass, forces) = state_forces(&state, area)?;
+        // A corrugated state is not funicular for its loads: the network carries their
+        // funicular part exactly, the shell the rest (`split_state_forces`).
+        let (topology, pass, forces) = if corrugated {
+            let (t, p, f, _) = split_state_forces(&state, area)?;
+            (t, p, f)
+        } else {
+            state_forces(&state, area)?
+        };
         context.step(total);
         let summary = StateSummary {
             index: state.index,

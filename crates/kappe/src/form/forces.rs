@@ -38,6 +38,15 @@ pub struct StateForces {
     pub min_column_hv_ratio: f64,
     /// Smallest and largest start-layer factor d of the state.
     pub factor_range: [f64; 2],
+    /// Largest node load the network does not carry axially and hands to the shell's bending
+    /// ([`split_state_forces`], corrugated caps), N; 0 (and not serialized) for a network in
+    /// exact equilibrium under its own loads.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub out_of_funicular: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// Cross-section areas used for stresses (method.md §3).
@@ -126,5 +135,63 @@ fn summarize(state: &State, topo: &Topology, fp: &ForcePass, areas: Sections2D) 
         max_column_hv_ratio: hv_max,
         min_column_hv_ratio: if hv_min.is_finite() { hv_min } else { 0.0 },
         factor_range: [fmin, fmax],
+        out_of_funicular: 0.0,
     }
+}
+
+/// The unbalanced force of every node of a force pass: `q_n + Σ_e F_e·û(x_m − x_n) + R_n` over
+/// the node's trail and deviation edges (tension positive), in topology node order. Its norm is
+/// the pass's node residual ρ_n (docs/corrugation.md, "State equilibrium"); it is zero at
+/// supports by construction.
+pub fn unbalanced_forces(topo: &Topology, fp: &ForcePass) -> Vec<V3> {
+    let mut out: Vec<V3> = topo
+        .nodes
+        .iter()
+        .zip(&fp.reactions)
+        .map(|(n, r)| n.load + r)
+        .collect();
+    let unit = |d: V3| {
+        let l = d.norm();
+        if l > 0.0 { d / l } else { V3::zeros() }
+    };
+    let mut add = |u: usize, v: usize, f: f64| {
+        let (Some(xu), Some(xv)) = (topo.nodes.get(u), topo.nodes.get(v)) else {
+            return;
+        };
+        let e = unit(xv.xyz - xu.xyz);
+        out[u] += e * f;
+        out[v] -= e * f;
+    };
+    for (e, &f) in topo.trail_edges.iter().zip(&fp.trail_forces) {
+        add(e.u as usize, e.v as usize, f);
+    }
+    for e in &topo.deviation_edges {
+        add(e.u as usize, e.v as usize, e.force);
+    }
+    out
+}
+
+/// The force pass of a state whose fixed geometry is not funicular for its loads (a corrugated
+/// cap, docs/corrugation.md "State equilibrium"): the first pass gives every node's unbalanced
+/// force `s_n` ([`unbalanced_forces`]); each node's load is split into `q_n − s_n`, which the
+/// network carries (a second pass under those loads, whose residual is round-off), and `s_n`,
+/// which the shell carries by bending (`crate::analysis::bending`). The member forces of both
+/// passes are the same (the split removes exactly what no edge took). Returns the second pass,
+/// its summary (`out_of_funicular` = max |s_n|) and `s_n` per node.
+pub fn split_state_forces(
+    state: &State,
+    areas: Sections2D,
+) -> Result<(Topology, ForcePass, StateForces, Vec<V3>), DesignError> {
+    let net = &state.network;
+    let positions = net.positions();
+    let mut topo = net.to_topology(&format!("state {}", state.index));
+    let first = kappe_cem::fixed_geometry::force_pass(&topo, &positions)?;
+    let unbalanced = unbalanced_forces(&topo, &first);
+    for (node, s) in topo.nodes.iter_mut().zip(&unbalanced) {
+        node.load -= s;
+    }
+    let fp = kappe_cem::fixed_geometry::force_pass(&topo, &positions)?;
+    let mut summary = summarize(state, &topo, &fp, areas);
+    summary.out_of_funicular = unbalanced.iter().fold(0.0, |m, s| m.max(s.norm()));
+    Ok((topo, fp, summary, unbalanced))
 }

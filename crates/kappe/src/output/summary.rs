@@ -161,6 +161,18 @@ pub struct StateEntry {
     pub max_tension_force_n: f64,
     /// Largest nodal equilibrium residual of the force pass, N.
     pub max_node_residual_n: f64,
+    /// A corrugated state: the largest node force its network hands to the shell's bending
+    /// (docs/corrugation.md, "State equilibrium"), N.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub out_of_funicular_n: Option<f64>,
+    /// A corrugated state: the shell statics' equilibrium residual of that bending part,
+    /// |Σ loads + Σ reactions|, N.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_residual_n: Option<f64>,
+    /// A corrugated state: the largest |σ| the bending part adds to a network element, Pa
+    /// (included in the element stresses).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending_stress_pa: Option<f64>,
     /// Most compressive element stress, Pa (the analysis' element stresses when analysed).
     pub max_compression_stress_pa: f64,
     /// Largest element stress, Pa.
@@ -493,6 +505,10 @@ impl Outcome {
                     max_compression_force_n: s.forces.max_compression_force,
                     max_tension_force_n: s.forces.max_tension_force,
                     max_node_residual_n: s.forces.max_residual,
+                    out_of_funicular_n: (s.forces.out_of_funicular > 0.0)
+                        .then_some(s.forces.out_of_funicular),
+                    bending_residual_n: a.and_then(|a| a.bending).map(|b| b.equilibrium_residual_n),
+                    bending_stress_pa: a.and_then(|a| a.bending).map(|b| b.max_stress_pa),
                     max_compression_stress_pa: a.map_or(s.forces.max_compression_stress, |a| {
                         a.max_compression_stress_pa
                     }),

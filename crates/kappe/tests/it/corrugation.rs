@@ -177,6 +177,16 @@ fn a_wave_too_short_or_too_deep_is_a_named_error() {
     let (field, allowed) = err("[cap.corrugation]\namplitude = 0.17\nwavelength = 0.3\n");
     assert_eq!(field, "cap.corrugation.amplitude");
     assert!(allowed.contains("30.0 mm"), "{allowed}");
+    // A crown above the span: rise 0.75 + a 0.1 = 850 mm > span 800 mm (rise/span > 1).
+    match Design::from_toml_str(
+        "[cap]\nrise = 0.75\n[cap.corrugation]\namplitude = 0.1\nwavelength = 0.3\n",
+    ) {
+        Err(DesignError::Invalid { field, allowed, .. }) => {
+            assert_eq!(field, "cap.corrugation.amplitude");
+            assert!(allowed.contains("850.0 mm"), "{allowed}");
+        }
+        other => panic!("expected an Invalid error, got {other:?}"),
+    }
     let (field, _) = err("[cap.corrugation]\namplitude = -0.01\nwavelength = 0.3\n");
     assert_eq!(field, "cap.corrugation.amplitude");
     assert!(
@@ -317,4 +327,175 @@ fn a_corrugated_plate_buckles_at_its_orthotropic_estimate() {
     );
     // The stiffening itself: 1 + 6a²/t² ≈ 10.4 in the small-slope limit.
     assert!(wavy / flat > 9.0, "stiffening only {}", wavy / flat);
+}
+
+/// Issue 26, verification: every corrugated print state is in equilibrium. The network carries
+/// the funicular part of each state's loads exactly (its force pass residual ≤ 1e-9 N) and in
+/// compression; the rest, the force a fixed wavy geometry cannot carry axially, is real (not
+/// round-off) and is carried by the state's shell, whose statics balance it (|Σ loads +
+/// Σ reactions| ≤ 1e-9 N) and whose stresses widen the element stresses on both sides.
+#[test]
+fn every_corrugated_state_is_in_equilibrium_network_plus_shell() {
+    use kappe::analysis::corrugated_stresses;
+    use kappe::analysis::{AnalysisOptions, element_stresses, state_material};
+    use kappe::form::build_state;
+    let d = small(WAVE);
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let mut handed: f64 = 0.0;
+    for s in &cap.states {
+        // 1e-9 N, the issue's bound; forces are O(10 N), so this is ~1e5 ulp of the node sums.
+        assert!(
+            s.forces.max_residual <= 1e-9,
+            "state {}: network residual {:.3e} N",
+            s.index,
+            s.forces.max_residual
+        );
+        // Compression, zero allowed: a near-zero edge may round to +1e-14 N, so the bound is
+        // method.md §9's residual tolerance 1e-9·(1 + max|F|).
+        assert!(
+            s.forces.max_tension_force <= s.forces.residual_tolerance,
+            "state {}: tension {} N",
+            s.index,
+            s.forces.max_tension_force
+        );
+        handed = handed.max(s.forces.out_of_funicular);
+    }
+    // The split is not vacuous: the wave's columns kink, and the shell takes a real load
+    // (the default-scale cap hands over 0.5–1.4 N, docs/corrugation.md).
+    assert!(handed > 0.05, "largest handed-over force {handed} N");
+
+    let o = AnalysisOptions::default();
+    let areas = cap.areas();
+    let last = cap.states.len() - 1;
+    for top in [cap.sections.n_start + 4, last] {
+        let state = build_state(&cap.sections, &cap.frame, 0.0, top).unwrap();
+        let mat = state_material(&cap, &o, top).unwrap();
+        let (all, bending) = corrugated_stresses(&state, areas, &mat).unwrap();
+        let b = bending.expect("a corrugated state has a bending part");
+        assert!(b.load_sum_n > 0.0 && b.out_of_funicular_n > 0.0);
+        // The shell's global equilibrium, 1e-9 N: its loads are O(1 N) and the solve is a
+        // direct Cholesky factorization (relative residual ~1e-12 of K's scale).
+        assert!(
+            b.equilibrium_residual_n <= 1e-9,
+            "state {top}: shell residual {:.3e} N",
+            b.equilibrium_residual_n
+        );
+        // Both faces of every element are there, and the bending widens the network's range.
+        let net = element_stresses(&state, areas).unwrap();
+        assert_eq!(all.len(), 2 * net.len());
+        let lo = |v: &[kappe::analysis::ElementStress]| {
+            v.iter().map(|e| e.stress).fold(f64::INFINITY, f64::min)
+        };
+        let hi = |v: &[kappe::analysis::ElementStress]| {
+            v.iter().map(|e| e.stress).fold(f64::NEG_INFINITY, f64::max)
+        };
+        // The start section's springing stays the most compressed element (its bending part
+        // is ~0), so only "not above" there; every network stress here is ≤ 0, so the
+        // bending's tension face must raise the highest.
+        assert!(lo(&all) <= lo(&net) && hi(&all) > hi(&net));
+        assert!(b.max_stress_pa > 0.0);
+    }
+}
+
+/// `kappe optimize` takes the corrugation as free parameters (issue 26): from a smooth start
+/// (no `[cap.corrugation]`), the amplitude step reaches the pipeline — the evaluated design is
+/// corrugated (its volume differs from the smooth cap's, and its bending part shows in the
+/// stress check) — and the result is what `kappe design` says of it.
+#[test]
+fn optimize_varies_the_corrugation() {
+    use kappe::commands::optimize::{OptimizeFile, optimize};
+    let d = Design::from_toml_str(
+        "[cap]\nlength = 0.2\n[print]\nlayer_height = 0.015\n[constraints]\noverhang_max = 0.05\n\
+         [robot]\nenabled = false\n",
+    )
+    .unwrap();
+    let text = "max_evaluations = 3\n\
+                [analysis]\nbuckling = false\n[verify]\nbuckling = false\n\
+                [free]\n\"cap.corrugation.amplitude\" = { min = 0.0, max = 0.03 }\n\
+                \"cap.corrugation.wavelength\" = { min = 0.15, max = 0.3 }\n";
+    let f = OptimizeFile::from_toml_str(text).unwrap();
+    let r = optimize(&f, &d, &|_| std::ops::ControlFlow::Continue(())).unwrap();
+    let first = &r.evaluations[0];
+    // The smooth start: amplitude 0, the default wavelength 0.3 m.
+    assert_eq!(first.parameters["cap.corrugation.amplitude"], 0.0);
+    assert_eq!(first.parameters["cap.corrugation.wavelength"], 0.3);
+    let waved = r
+        .evaluations
+        .iter()
+        .find(|e| e.parameters["cap.corrugation.amplitude"] > 0.0)
+        .expect("the search never tried a wave");
+    // The wave changes every centre layer's arch length, so the printed volume.
+    let (v0, v1) = (first.volume_m3.unwrap(), waved.volume_m3.unwrap());
+    assert!((v1 - v0).abs() > 1e-9 * v0, "{v0} vs {v1}");
+    // The result is `kappe design`'s verdict on it.
+    assert_eq!(r.feasible, r.verdict.as_ref().is_some_and(|v| v.ok));
+}
+
+/// The robot prints a corrugated cap (issue 26, item 2): the planned targets are the layers'
+/// own (wavy) nozzle-tip points, every layer is one continuous bead at the print speed, and the
+/// programs pass the URScript check.
+#[test]
+fn the_nozzle_follows_the_waves() {
+    let d = Design::from_toml_str(&format!(
+        "[cap]\nlength = 0.2\n[print]\nlayer_height = 0.015\n[constraints]\noverhang_max = 0.05\n{WAVE}"
+    ))
+    .unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let plan = kappe::robot_plan::plan_robot(&cap).unwrap();
+    let tips: std::collections::HashMap<(i64, usize), V3> = cap
+        .path
+        .points
+        .iter()
+        .map(|p| ((i64::from(p.layer), p.index), p.tip))
+        .collect();
+    // The wave is in the path: the crown tips of the centre layers do not lie on one line
+    // (a prism's would, every layer being layer 0 translated).
+    let crown_z: Vec<f64> = (0..cap.sections.n_centre as i64)
+        .filter_map(|k| {
+            cap.path
+                .points
+                .iter()
+                .filter(|p| i64::from(p.layer) == k)
+                .map(|p| p.tip.z)
+                .reduce(f64::max)
+        })
+        .collect();
+    let spread = crown_z.iter().fold(f64::NEG_INFINITY, |a, &b| a.max(b))
+        - crown_z.iter().fold(f64::INFINITY, |a, &b| a.min(b));
+    assert!(spread > 0.02, "crown tips spread {spread} m");
+    let mut visited = 0;
+    for st in &plan.stations {
+        for l in &st.layers {
+            for (k, w) in l.waypoints.iter().enumerate() {
+                let tip = tips[&(l.layer, w.index)];
+                // The planner keeps the target it was given (copied, so exact; 1e-12 m allows
+                // an f32-free round trip through the plan's own arrays).
+                let err = (V3::from(w.position) - tip).norm();
+                assert!(
+                    err <= 1e-12,
+                    "layer {} point {}: target off by {err} m",
+                    l.layer,
+                    w.index
+                );
+                // Continuous flow: inside a layer every move prints, at the print speed unless
+                // the timing slowed it (then still > 0).
+                if k > 0 {
+                    if plan.slowdowns.is_empty() {
+                        let v = d.print.print_speed;
+                        assert!((w.speed - v).abs() <= 1e-9 * v, "speed {} m/s", w.speed);
+                    } else {
+                        assert!(w.speed > 0.0);
+                    }
+                }
+                visited += 1;
+            }
+        }
+    }
+    assert_eq!(
+        visited,
+        cap.path.points.len(),
+        "every path point is a target"
+    );
+    let files = kappe_robot::files::linted_programs(&plan, "corrugated").unwrap();
+    assert!(!files.is_empty());
 }

@@ -247,10 +247,10 @@ fn moving_base_limits_are_validated_by_name() {
 /// `form::states`, ≈ 1e-8 for this bay), and an intermediate state still has d in [0, 1].
 #[test]
 fn long_bay_start_section_final_state_builds() {
-    use kappe::form::arch::{ArchSpec, form_find_layer};
-    use kappe::form::frame::LayerFrame;
-    use kappe::form::section::build_sections;
-    use kappe::form::states::build_state;
+    use kappe::form::LayerFrame;
+    use kappe::form::build_state;
+    use kappe::form::{ArchSpec, form_find_layer};
+    use kappe::form::{EndKind, build_sections_with_end};
     let d = Design::from_toml_str(kappe::commands::templates::MOVING_TOML).unwrap();
     assert_eq!((d.cap.span, d.cap.length), (1.5, 4.0), "the issue's bay");
     let tilt = d.tilt();
@@ -268,13 +268,14 @@ fn long_bay_start_section_final_state_builds() {
     let w = d.material.specific_weight * d.print.layer_width * d.print.layer_height;
     let phi = d.print.start_arch_fraction;
     assert_eq!(phi, 0.0, "the bound case: φ = 0");
-    let s = build_sections(
+    let s = build_sections_with_end(
         &arch,
         &frame,
         d.cap.length,
         d.print.layer_height,
         phi,
         |c| 0.5 * c * w,
+        EndKind::StartSection,
     )
     .unwrap();
     assert!(
