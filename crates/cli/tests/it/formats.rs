@@ -126,7 +126,14 @@ fn moving_example_runs() {
     let path = tmp.path().join(&file);
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("span = 1.5") && text.contains("length = 4.0"));
-    std::fs::write(&path, text.replacen("length = 4.0", "length = 0.2", 1)).unwrap();
+    // A compression limit the short bay cannot meet, so it runs as the failing design the
+    // full bay is (issue 28: its tracking programs must say so).
+    assert!(!text.contains("[constraints]"));
+    std::fs::write(
+        &path,
+        text.replacen("length = 4.0", "length = 0.2", 1) + "\n[constraints]\nsigma_min = -1.0\n",
+    )
+    .unwrap();
     let o = kappe(
         tmp.path(),
         &["design", &file, "--out", "o", "--quiet", "--allow-fail"],
@@ -136,6 +143,23 @@ fn moving_example_runs() {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert!(s["robot"]["base_trajectory"]["length_m"].as_f64().unwrap() > 0.0);
+    assert_eq!(s["ok"], false, "the design must fail sigma_min = -1 Pa");
+    // The failing design's tracking programs carry the mark the station programs carry: the
+    // WARNING line, and `failing_design` in programs.json (issue 28, defect 5).
+    let prog = std::fs::read_to_string(out.join("program_part01.script")).unwrap();
+    assert!(
+        prog.lines()
+            .take(4)
+            .any(|l| l.starts_with("# WARNING: the design FAILS")),
+        "{}",
+        prog.lines().take(4).collect::<Vec<_>>().join("\n")
+    );
+    let index: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("programs.json")).unwrap()).unwrap();
+    assert!(
+        index["programs"][0]["failing_design"].is_string(),
+        "{index}"
+    );
     let head = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     assert!(
         head.lines()

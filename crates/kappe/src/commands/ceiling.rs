@@ -746,7 +746,11 @@ impl BayOutcome {
             // A moving base: each half's tracking programs and base trajectory (issue 27).
             match (&eval.robot, &eval.moving) {
                 (Some(Ok(_)), Some(m)) => {
-                    out.extend(moving_plan_files(&m.plan, "program_part", true)?);
+                    out.extend(moving_plan_files(
+                        &eval.marked_moving(&m.plan),
+                        "program_part",
+                        true,
+                    )?);
                 }
                 (Some(Ok(plan)), None) => {
                     let plan = eval.marked_plan(plan);
@@ -756,7 +760,7 @@ impl BayOutcome {
                 _ => {}
             }
             if let Some(mp) = &self.mirror_moving {
-                let files = moving_plan_files(mp, "program_part", true)?;
+                let files = moving_plan_files(&eval.marked_moving(mp), "program_part", true)?;
                 out.extend(files.into_iter().map(|f| f.under("mirror")));
             } else if let Some(Ok(plan)) = &self.mirror_plan {
                 let plan = eval.marked_plan(plan);

@@ -150,7 +150,7 @@ impl Outcome {
         out.push(OutputFile::new("schedule.csv", self.schedule.to_csv()));
         match (&self.robot, &self.moving) {
             (Some(Ok(_)), Some(m)) => out.extend(moving_plan_files(
-                &m.plan,
+                &self.marked_moving(&m.plan),
                 "program_part",
                 self.programs().is_ok(),
             )?),
@@ -201,6 +201,14 @@ impl Outcome {
             });
         }
         plan
+    }
+
+    /// [`Outcome::marked_plan`] for a moving plan: its arm plan marked, so the tracking
+    /// programs and `plan.json` of a failing design say so as the station programs do.
+    pub fn marked_moving(&self, mp: &kappe_robot::MovingPlan) -> kappe_robot::MovingPlan {
+        let mut mp = mp.clone();
+        mp.plan = self.marked_plan(&mp.plan);
+        mp
     }
 
     /// The table `kappe design` prints: the design, the layer arch, the states, the worst
