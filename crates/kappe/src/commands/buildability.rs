@@ -844,6 +844,27 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
             "  (closed-form uniaxial plastic collapse at the base: layer {n})"
         );
     }
+    if let Some(rel) = &b.reliability {
+        let _ = writeln!(
+            t,
+            "reliability: print β {:.2}, P_f {:.3e} (governing: layer {} {})",
+            rel.beta, rel.pf, rel.governing_state, rel.governing_check
+        );
+    }
+    if let Some(mc) = &b.monte_carlo {
+        let _ = writeln!(
+            t,
+            "Monte Carlo ({} samples): P_f {:.4} [{:.4}, {:.4}], failure layer {}",
+            mc.samples,
+            mc.pf,
+            mc.pf_interval[0],
+            mc.pf_interval[1],
+            match (mc.failure_layer_mean, mc.failure_layer_std) {
+                (Some(m), Some(s)) => format!("{m:.1} ± {s:.1}"),
+                _ => "-".into(),
+            }
+        );
+    }
     if let Some(out) = out {
         let _ = writeln!(t, "wrote {}", out.display());
     }
