@@ -19,7 +19,8 @@
 //! Kiureghian, *Structural and System Reliability*, 2022, §5.4). The term ‖uₖ + dₖ‖ keeps c > 0 at
 //! the origin and makes the full step acceptable whenever G is linear (then m(uₖ + dₖ) ≤ m(uₖ)
 //! for any start), so a linear limit state converges in one step as with plain HL-RF. Convergence: |G(uₖ)|/|G(u₀)| ≤ ε_G and ‖uₖ − (αₖᵀuₖ)αₖ‖ ≤ ε_u (the point is on
-//! the surface and u is parallel to the gradient). The start is the mean point.
+//! the surface and u is parallel to the gradient; ε_u is scaled by max(1, ‖uₖ‖), an angle rather
+//! than a distance far out). The start is the mean point.
 //!
 //! # Gradients
 //!
@@ -54,7 +55,7 @@ pub struct FormOptions {
     pub max_iterations: usize,
     /// ε_G: |G|/|G(start)| at convergence (default 10⁻⁶; |G| itself when G(start) = 0).
     pub g_tolerance: f64,
-    /// ε_u: ‖u − (αᵀu)α‖ at convergence (default 10⁻⁶).
+    /// ε_u: ‖u − (αᵀu)α‖ / max(1, ‖u‖) at convergence (default 10⁻⁶).
     pub u_tolerance: f64,
     /// Central-difference step in standard deviations (default 10⁻⁵).
     pub fd_step: f64,
@@ -272,7 +273,9 @@ pub fn form<L: LimitState + ?Sized>(
                 .map(|(ui, ai)| ui - beta * ai)
                 .collect::<Vec<_>>(),
         );
-        if g_res <= options.g_tolerance && u_res <= options.u_tolerance {
+        // ε_u is relative to ‖u‖ beyond 1: the direction's angle, not an absolute distance,
+        // which central-difference gradients cannot resolve below ~1e-8·‖u‖ far out (β ≫ 10).
+        if g_res <= options.g_tolerance && u_res <= options.u_tolerance * norm(&u).max(1.0) {
             return Ok(finish(
                 model, u, x, g, alpha, beta, g_res, u_res, iteration, &ev,
             ));

@@ -48,8 +48,9 @@ pub use form::{FormOptions, FormResult, form};
 pub use limit_state::{Fallible, LimitState, WithGradient};
 pub use model::{Correlation, Model};
 pub use sampling::{
-    Batch, BlockSums, SamplingBatch, SamplingMethod, SamplingOptions, SamplingResult,
-    importance_sampling, merge, monte_carlo, sample_batch, sample_batch_parallel,
+    Batch, BlockSums, EventBatch, EventBlock, SamplingBatch, SamplingMethod, SamplingOptions,
+    SamplingResult, importance_sampling, merge, merge_events, monte_carlo, sample_batch,
+    sample_batch_parallel, sample_events,
 };
 pub use spec::{DistKind, UncertaintySpec};
 pub use system::{Component, SystemOptions, SystemResult, series_system};

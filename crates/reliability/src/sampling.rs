@@ -398,3 +398,131 @@ pub fn importance_sampling<L: LimitState + ?Sized>(
     )?;
     merge(&[batch])
 }
+
+/// Counts of several failure events in one block (see [`sample_events`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventBlock {
+    /// Block index.
+    pub block: u64,
+    /// Samples in the block.
+    pub samples: u64,
+    /// Per event, the samples in which it occurred.
+    pub counts: Vec<u64>,
+}
+
+/// What one batch of [`sample_events`] returns (serialisable for a Dask worker).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventBatch {
+    /// The run's options.
+    pub options: SamplingOptions,
+    /// Number of events.
+    pub events: usize,
+    /// This batch's blocks, in order.
+    pub blocks: Vec<EventBlock>,
+}
+
+/// Crude Monte Carlo of `events` failure events at once on the same samples (e.g. "state n
+/// fails" for every state of a print): `indicator(u, x, hits)` sets `hits[k]` when event k occurs
+/// at the sample (u in standard normal space, x = the model's physical values; a caller with
+/// drifted models maps u itself). Blocks draw exactly the numbers of [`monte_carlo`] with the
+/// same options (the same stream per block, one word per normal), run in parallel (rayon) and
+/// are kept in order, so batches merge ([`merge_events`]) into the single run bit for bit.
+///
+/// # Errors
+/// Invalid options or a failing indicator.
+pub fn sample_events<F>(
+    model: &Model,
+    events: usize,
+    indicator: &F,
+    options: &SamplingOptions,
+    batch: Batch,
+) -> Result<EventBatch>
+where
+    F: Fn(&[f64], &[f64], &mut [bool]) -> Result<(), EvalError> + Sync,
+{
+    check(model, &SamplingMethod::MonteCarlo, options, batch)?;
+    let (first, last) = block_range(options, batch);
+    let blocks = (first..last)
+        .into_par_iter()
+        .map(|b| {
+            let mut u = vec![0.0; model.len()];
+            let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+            rng.set_stream(b);
+            let count = options
+                .block_size
+                .min(options.samples - b * options.block_size);
+            let mut counts = vec![0u64; events];
+            let mut hits = vec![false; events];
+            for _ in 0..count {
+                for v in u.iter_mut() {
+                    *v = rng::std_normal(&mut rng);
+                }
+                let x = model.x_from_u(&u);
+                hits.iter_mut().for_each(|h| *h = false);
+                indicator(&u, &x, &mut hits).map_err(|source| Error::LimitState {
+                    x: x.clone(),
+                    source,
+                })?;
+                for (c, h) in counts.iter_mut().zip(&hits) {
+                    *c += u64::from(*h);
+                }
+            }
+            Ok(EventBlock {
+                block: b,
+                samples: count,
+                counts,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(EventBatch {
+        options: options.clone(),
+        events,
+        blocks,
+    })
+}
+
+/// Merges the batches of one [`sample_events`] run into a crude Monte Carlo estimate per event
+/// (the same estimator and interval as [`merge`]).
+///
+/// # Errors
+/// Batches of different runs, or missing or duplicate blocks.
+pub fn merge_events(batches: &[EventBatch]) -> Result<Vec<SamplingResult>> {
+    let first = batches.first().ok_or_else(|| Error::BatchMerge {
+        reason: "no batches".to_owned(),
+    })?;
+    if batches
+        .iter()
+        .any(|b| b.options != first.options || b.events != first.events)
+    {
+        return Err(Error::BatchMerge {
+            reason: "batches of different runs (options or event counts differ)".to_owned(),
+        });
+    }
+    // Each event as a one-event SamplingBatch: the same merge (checks, sums and interval).
+    (0..first.events)
+        .map(|k| {
+            let as_batches: Vec<SamplingBatch> = batches
+                .iter()
+                .map(|b| SamplingBatch {
+                    method: SamplingMethod::MonteCarlo,
+                    options: b.options.clone(),
+                    blocks: b
+                        .blocks
+                        .iter()
+                        .map(|e| {
+                            let f = e.counts.get(k).copied().unwrap_or(0);
+                            BlockSums {
+                                block: e.block,
+                                samples: e.samples,
+                                failures: f,
+                                sum_w: f as f64,
+                                sum_w2: f as f64,
+                            }
+                        })
+                        .collect(),
+                })
+                .collect();
+            merge(&as_batches)
+        })
+        .collect()
+}

@@ -179,6 +179,57 @@ pub fn check_state(
     options: &GreenOptions,
     start: Option<ModeStart>,
 ) -> Result<(GreenState, Option<ModeStart>), DesignError> {
+    let want_stress = (options.strength || options.sliding) && time.strength.is_some();
+    let (buckling, static_result, mode) =
+        solve_state(model, elements, ages, time, options, start, want_stress)?;
+    let (strength, sliding) = match (want_stress, &static_result) {
+        (true, Some(st)) => stress_checks(st, elements, ages, time, options),
+        _ => (None, None),
+    };
+
+    let buckling_u = match &buckling {
+        BucklingOutcome::Factor { blf } => Some(options.blf_min / blf),
+        BucklingOutcome::Mechanism { .. } => Some(f64::INFINITY),
+        _ => None,
+    };
+    let candidates = [
+        (FailureMode::Buckling, buckling_u),
+        (FailureMode::Strength, strength.map(|w| w.utilisation)),
+        (FailureMode::Sliding, sliding.map(|w| w.utilisation)),
+    ];
+    let governing = candidates
+        .iter()
+        .filter_map(|(m, u)| u.map(|u| (*m, u)))
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    let failure = governing.filter(|(_, u)| *u > 1.0).map(|g| g.0);
+    Ok((
+        GreenState {
+            buckling,
+            strength,
+            sliding,
+            failure,
+            governing: governing.map(|g| g.0),
+        },
+        mode,
+    ))
+}
+
+/// The solves behind [`check_state_warm`]: the aged moduli set on `model` (each element the
+/// mean of its two layers' E), the buckling solve (when `options.buckling`) and the pre-buckling
+/// static solution (also without buckling when `want_stress`), and mode 1. Shared with the
+/// buildability reliability, which needs the whole stress field, not only the worst elements.
+///
+/// # Errors
+/// A failed FE solve other than a mechanism.
+pub fn solve_state(
+    model: &mut ShellModel,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+    options: &GreenOptions,
+    start: Option<ModeStart>,
+    want_stress: bool,
+) -> Result<SolvedState, DesignError> {
     let mut mode = None;
     let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
     let base = model.material_of(0);
@@ -192,7 +243,6 @@ pub fn check_state(
             })
             .collect();
     }
-    let want_stress = (options.strength || options.sliding) && time.strength.is_some();
     let (buckling, static_result) = if options.buckling {
         let opts = BucklingOptions {
             modes: 1,
@@ -234,37 +284,15 @@ pub fn check_state(
         (BucklingOutcome::Skipped, None)
     };
 
-    let (strength, sliding) = match (want_stress, &static_result) {
-        (true, Some(st)) => stress_checks(st, elements, ages, time, options),
-        _ => (None, None),
-    };
-
-    let buckling_u = match &buckling {
-        BucklingOutcome::Factor { blf } => Some(options.blf_min / blf),
-        BucklingOutcome::Mechanism { .. } => Some(f64::INFINITY),
-        _ => None,
-    };
-    let candidates = [
-        (FailureMode::Buckling, buckling_u),
-        (FailureMode::Strength, strength.map(|w| w.utilisation)),
-        (FailureMode::Sliding, sliding.map(|w| w.utilisation)),
-    ];
-    let governing = candidates
-        .iter()
-        .filter_map(|(m, u)| u.map(|u| (*m, u)))
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    let failure = governing.filter(|(_, u)| *u > 1.0).map(|g| g.0);
-    Ok((
-        GreenState {
-            buckling,
-            strength,
-            sliding,
-            failure,
-            governing: governing.map(|g| g.0),
-        },
-        mode,
-    ))
+    Ok((buckling, static_result, mode))
 }
+
+/// Buckling outcome, the static solution (None: not solved or a mechanism) and mode 1.
+pub type SolvedState = (
+    BucklingOutcome,
+    Option<kappe_fe::StaticResult>,
+    Option<ModeStart>,
+);
 
 /// The worst strength and the worst bed-joint sliding element of a state.
 pub type StressWorst = (Option<WorstElement>, Option<WorstElement>);

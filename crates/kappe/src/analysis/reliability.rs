@@ -44,6 +44,9 @@ use crate::input::uncertainty::BETA_MIN_DEFAULT;
 /// scatter, large against the eigensolver's relative residual (1e-8) times BLF/h.
 pub const NU_STEP: f64 = 1e-3;
 
+/// β beyond which a component that FORM cannot converge is left out of a state (P_f < 1e-15).
+pub const FAR_BETA: f64 = 8.0;
+
 /// Samples of each state's own series system (its few checks).
 const STATE_SYSTEM_SAMPLES: u64 = 4_000;
 
@@ -497,30 +500,74 @@ pub fn state_form(
             field: "uncertainty.drift".into(),
             message: format!("state {index} at {t_hours:.3} h: {e}"),
         })?;
+    let time = if checks
+        .iter()
+        .any(|c| matches!(c, Check::BucklingTime { .. }))
+    {
+        Some(cap.design.time_model()?)
+    } else {
+        None
+    };
+    let mut states: Vec<Box<dyn kappe_reliability::LimitState + '_>> = Vec::new();
+    for &check in checks {
+        states.push(match (check, &time) {
+            (Check::BucklingTime { blf, s_nu, top }, Some(time)) => Box::new(TimeBuckling {
+                cap,
+                options,
+                schedule,
+                time: time.clone(),
+                vars: v,
+                check: (blf, s_nu, top),
+                blf_min: k.blf_min,
+                shell0: None,
+            }),
+            _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
+                limit_state(check, v, limits, x, grad)
+            })),
+        });
+    }
+    let named = checks.iter().map(|c| c.name()).zip(states).collect();
+    form_checks(&state_model, named, index, t_hours, seed)
+        .map(Some)
+        .map_err(rel_err)
+}
+
+/// FORM of each named limit state of one state in the state's (drifted) `model`, and the
+/// state's β and P_f as a series system of them ([`STATE_SYSTEM_SAMPLES`] importance samples,
+/// `seed`); `beta_by_check` holds each name's lowest β. The one implementation behind the cap's
+/// states and the buildability objects' states.
+///
+/// # Errors
+/// FORM that does not converge, or no limit state.
+pub fn form_checks<'a>(
+    model: &Model,
+    checks: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)>,
+    index: usize,
+    t_hours: f64,
+    seed: u64,
+) -> Result<StateForm, kappe_reliability::Error> {
     let mut by_check = BTreeMap::new();
     let mut own = Vec::new();
     let mut results = Vec::new();
-    for &check in checks {
-        let r = match check {
-            Check::BucklingTime { blf, s_nu, top } => {
-                let mut g = TimeBuckling {
-                    cap,
-                    options,
-                    schedule,
-                    time: cap.design.time_model()?,
-                    vars: v,
-                    check: (blf, s_nu, top),
-                    blf_min: k.blf_min,
-                    shell0: None,
-                };
-                form(&state_model, &mut g, &FormOptions::default())
+    for (name, mut g) in checks {
+        let r = match form(model, g.as_mut(), &FormOptions::default()) {
+            Ok(r) => r,
+            // A component whose HL-RF iterates stay beyond β = FAR_BETA without converging (the
+            // difference gradients meet round-off there) is left out: its P_f < 1e-15 cannot
+            // move the state's. Any other failure is an error.
+            Err(kappe_reliability::Error::FormNotConverged { beta, .. }) if beta > FAR_BETA => {
+                continue;
             }
-            _ => check_form(&state_model, check, v, limits),
-        }
-        .map_err(rel_err)?;
-        by_check.insert(check.name().to_owned(), r.beta);
+            Err(e) => return Err(e),
+        };
+        // Several components of one check (e.g. a buildability object's layers): the
+        // weakest one's β.
+        by_check
+            .entry(name.to_owned())
+            .and_modify(|b: &mut f64| *b = b.min(r.beta))
+            .or_insert(r.beta);
         own.push(Component::from(&r));
-        results.push((check.name(), r));
+        results.push((name, r));
     }
     let sys = series_system(
         &own,
@@ -529,9 +576,8 @@ pub fn state_form(
             seed,
             ditlevsen: false,
         },
-    )
-    .map_err(rel_err)?;
-    Ok(Some((
+    )?;
+    Ok((
         StateReliability {
             index,
             t_hours,
@@ -540,7 +586,7 @@ pub fn state_form(
             beta_by_check: by_check,
         },
         results,
-    )))
+    ))
 }
 
 fn rel_err(e: kappe_reliability::Error) -> DesignError {
@@ -580,7 +626,6 @@ pub fn reliability(
     let v = Vars::of(&model, cap);
     let k = &cap.design.constraints;
     let per_state = state_checks(cap, analysis, schedule, v)?;
-    let mut components: Vec<Component> = Vec::new();
     let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
     let mut states = Vec::new();
     // States are independent (each its own FORM, its own re-solves): in parallel, collected in
@@ -603,12 +648,11 @@ pub fn reliability(
     for (state, rs) in per_state.into_iter().flatten() {
         let index = state.index;
         for (name, r) in rs {
-            components.push(Component::from(&r));
             results.push((index, name, r));
         }
         states.push(state);
     }
-    if components.is_empty() {
+    if results.is_empty() {
         return Err(DesignError::Uncertainty {
             field: "uncertainty".into(),
             message: "no analysed check depends on the uncertain parameters (buckling needs an \
@@ -616,15 +660,35 @@ pub fn reliability(
                 .into(),
         });
     }
-    let sys = series_system(
-        &components,
+    print_reliability(
+        results,
+        states,
         &SystemOptions {
             samples: table.system_samples.unwrap_or(20_000),
             seed: table.seed.unwrap_or(0),
             ditlevsen: false,
         },
+        k.beta_min.unwrap_or(BETA_MIN_DEFAULT),
+        t0,
     )
-    .map_err(rel_err)?;
+    .map(Some)
+}
+
+/// The print's reliability from every state's FORM results (state index, check name, result):
+/// the series system over all of them, its governing component's design point and
+/// sensitivities. The one implementation behind the cap's and the buildability objects' blocks.
+///
+/// # Errors
+/// No component, or a failed series-system estimate.
+pub fn print_reliability(
+    results: Vec<(usize, &'static str, FormResult)>,
+    states: Vec<StateReliability>,
+    system: &SystemOptions,
+    beta_min: f64,
+    t0: kappe_fe::clock::Instant,
+) -> Result<Reliability, DesignError> {
+    let components: Vec<Component> = results.iter().map(|(_, _, r)| Component::from(r)).collect();
+    let sys = series_system(&components, system).map_err(rel_err)?;
     let Some((gov_state, gov_check, gov)) = results.get(sys.governing) else {
         return Err(rel_err(kappe_reliability::Error::NoComponents));
     };
@@ -645,11 +709,11 @@ pub fn reliability(
             )
         })
         .collect();
-    Ok(Some(Reliability {
+    Ok(Reliability {
         beta: sys.beta,
         pf: sys.pf,
         pf_interval: sys.interval,
-        beta_min: k.beta_min.unwrap_or(BETA_MIN_DEFAULT),
+        beta_min,
         governing_state: *gov_state,
         governing_check: (*gov_check).to_owned(),
         design_point,
@@ -657,5 +721,5 @@ pub fn reliability(
         states,
         components: components.len(),
         seconds: t0.elapsed().as_secs_f64(),
-    }))
+    })
 }

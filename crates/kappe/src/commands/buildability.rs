@@ -148,6 +148,10 @@ pub struct BuildabilitySpec {
     /// `[analysis]`: the nonlinear collapse check (`[analysis.nonlinear]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub analysis: Option<BuildAnalysis>,
+    /// `[uncertainty]`: the chance the object stands (issue 24;
+    /// [`crate::commands::buildability_reliability`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uncertainty: Option<crate::input::uncertainty::UncertaintyTable>,
 }
 
 /// `[analysis]` of a buildability spec.
@@ -359,14 +363,19 @@ impl BuildabilitySpec {
             other => other,
         })?;
         let schedule = Schedule::uniform(o.max_layers, layer_time, &waits)?;
-        Ok(Resolved {
+        let resolved = Resolved {
             spec: self.clone(),
             time,
             layer_time,
             schedule,
             segments,
             path_length,
-        })
+        };
+        if let Some(table) = &self.uncertainty {
+            // Checked here so that a bad table stops before anything is solved or written.
+            crate::commands::buildability_reliability::prepare(&resolved, table)?;
+        }
+        Ok(resolved)
     }
 }
 
@@ -468,6 +477,15 @@ pub struct BuildState {
     /// The collapse check in full (imperfection, LBA, sag at λ = 1, steps).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collapse: Option<Collapse>,
+    /// β of the state's random checks as a series system (with `[uncertainty]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// P_f of the state (with `[uncertainty]`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pf: Option<f64>,
+    /// β per check (`buckling`, `strength`, `sliding`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub beta_by_check: Option<std::collections::BTreeMap<String, f64>>,
 }
 
 /// The result (`buildability.json`).
@@ -492,6 +510,13 @@ pub struct Buildability {
     pub time_model: TimeModel,
     /// Per layer count, ascending.
     pub states: Vec<BuildState>,
+    /// The print's reliability by FORM (with `[uncertainty]`): β, P_f, design point and
+    /// sensitivities of the series system over the checked layer counts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reliability: Option<crate::analysis::reliability::Reliability>,
+    /// The print's crude Monte Carlo (with `[uncertainty] monte_carlo = N`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub monte_carlo: Option<crate::commands::buildability_reliability::PrintMonteCarlo>,
 }
 
 /// Check one layer count.
@@ -616,6 +641,9 @@ pub fn check_layers_warm(
             collapse_factor: collapse.as_ref().map(|x| x.factor),
             collapse_mode: collapse.as_ref().map(|x| x.mode),
             collapse,
+            beta: None,
+            pf: None,
+            beta_by_check: None,
         },
         mode,
     ))
@@ -679,6 +707,20 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
         states.extend(part);
         next = hi + 1;
     }
+    let (reliability, monte_carlo) = match &r.spec.uncertainty {
+        Some(table) => {
+            let (rel, mc) = crate::commands::buildability_reliability::analyse(r, table, &states)?;
+            for s in &mut states {
+                if let Some(x) = rel.states.iter().find(|x| x.index == s.layers) {
+                    s.beta = Some(x.beta);
+                    s.pf = Some(x.pf);
+                    s.beta_by_check = Some(x.beta_by_check.clone());
+                }
+            }
+            (Some(rel), mc)
+        }
+        None => (None, None),
+    };
     let first_fail = states.iter().find(|s| s.failure.is_some());
     Ok(Buildability {
         name: r.spec.name.clone(),
@@ -690,6 +732,8 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
         plastic_collapse_estimate: plastic_collapse_estimate(r),
         time_model: r.time.clone(),
         states,
+        reliability,
+        monte_carlo,
     })
 }
 
@@ -797,6 +841,27 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
         let _ = writeln!(
             t,
             "  (closed-form uniaxial plastic collapse at the base: layer {n})"
+        );
+    }
+    if let Some(rel) = &b.reliability {
+        let _ = writeln!(
+            t,
+            "reliability: print β {:.2}, P_f {:.3e} (governing: layer {} {})",
+            rel.beta, rel.pf, rel.governing_state, rel.governing_check
+        );
+    }
+    if let Some(mc) = &b.monte_carlo {
+        let _ = writeln!(
+            t,
+            "Monte Carlo ({} samples): P_f {:.4} [{:.4}, {:.4}], failure layer {}",
+            mc.samples,
+            mc.pf,
+            mc.pf_interval[0],
+            mc.pf_interval[1],
+            match (mc.failure_layer_mean, mc.failure_layer_std) {
+                (Some(m), Some(s)) => format!("{m:.1} ± {s:.1}"),
+                _ => "-".into(),
+            }
         );
     }
     if let Some(out) = out {

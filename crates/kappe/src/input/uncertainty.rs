@@ -50,6 +50,9 @@ pub const TIME_PARAMETERS: [&str; 2] = [
     "material.time.youngs_modulus_rate",
 ];
 
+/// A parameter's nominal value and whether it is positive, or why its name is not allowed.
+pub type Lookup<'a> = dyn Fn(&str) -> Result<(f64, bool), String> + 'a;
+
 /// The `[uncertainty]` table; see the module docs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UncertaintyTable {
@@ -65,6 +68,9 @@ pub struct UncertaintyTable {
     /// Seed of the series system's sampler (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
+    /// Crude Monte Carlo samples of the whole print (`kappe buildability` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monte_carlo: Option<u64>,
     /// The uncertain parameters, by the design file's names.
     #[serde(flatten)]
     pub parameters: BTreeMap<String, UncertaintySpec>,
@@ -118,38 +124,14 @@ impl UncertaintyTable {
                 ),
             ));
         }
-        let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
-        let known = |name: &str, context: &str| -> Result<(), DesignError> {
-            if TIME_PARAMETERS.contains(&name) && !time_model {
-                return Err(err(
-                    format!("{context}\"{name}\""),
-                    "a time-model parameter needs a time model: give [material.time] \
-                     (e.g. model = \"linear\" with youngs_modulus_rate)",
-                ));
-            }
-            if nominal(design, name).is_some() {
-                Ok(())
-            } else {
-                Err(err(
-                    format!("{context}\"{name}\""),
-                    format!("unknown parameter; allowed names: {}", allowed_names()),
-                ))
-            }
-        };
-        let mut variables = Vec::with_capacity(self.parameters.len());
-        for (name, spec) in &self.parameters {
-            known(name, "uncertainty.")?;
-            let (_, positive) = PARAMETERS
-                .iter()
-                .find(|(n, _)| n == name)
-                .copied()
-                .unwrap_or((name, false));
-            let nominal = nominal(design, name).unwrap_or(0.0);
-            let v = spec
-                .to_variable(name, nominal, positive)
-                .map_err(|e| err(format!("uncertainty.\"{name}\""), e))?;
-            variables.push(v);
+        if self.monte_carlo.is_some() {
+            return Err(err(
+                "uncertainty.monte_carlo".into(),
+                "a Monte Carlo of the whole print is for buildability specs (kappe \
+                 buildability); a design's states are checked by FORM",
+            ));
         }
+        let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
         if time_model && self.parameters.contains_key("material.youngs_modulus") {
             return Err(err(
                 "uncertainty.\"material.youngs_modulus\"".into(),
@@ -157,6 +139,47 @@ impl UncertaintyTable {
                  moduli do not use material.youngs_modulus; give the time model's own \
                  \"material.time.youngs_modulus\" and \"material.time.youngs_modulus_rate\"",
             ));
+        }
+        self.model_with(&|name: &str| {
+            if TIME_PARAMETERS.contains(&name) && !time_model {
+                return Err(
+                    "a time-model parameter needs a time model: give [material.time] \
+                     (e.g. model = \"linear\" with youngs_modulus_rate)"
+                        .to_owned(),
+                );
+            }
+            let positive = PARAMETERS.iter().find(|(n, _)| *n == name).map(|p| p.1);
+            match (nominal(design, name), positive) {
+                (Some(v), Some(p)) => Ok((v, p)),
+                _ => Err(format!(
+                    "unknown parameter; allowed names: {}",
+                    allowed_names()
+                )),
+            }
+        })
+    }
+
+    /// The reliability model of any input file: `lookup(name)` gives a parameter's nominal value
+    /// and whether it is positive, or the message of why the name is not allowed (the design's
+    /// [`UncertaintyTable::model`] and the buildability spec's share everything else).
+    pub fn model_with(&self, lookup: &Lookup<'_>) -> Result<Model, DesignError> {
+        if self.parameters.is_empty() {
+            return Err(err(
+                "uncertainty".into(),
+                "no uncertain parameter given; give at least one distribution keyed by a \
+                 parameter name",
+            ));
+        }
+        let known = |name: &str, context: &str| -> Result<(f64, bool), DesignError> {
+            lookup(name).map_err(|m| err(format!("{context}\"{name}\""), m))
+        };
+        let mut variables = Vec::with_capacity(self.parameters.len());
+        for (name, spec) in &self.parameters {
+            let (nominal, positive) = known(name, "uncertainty.")?;
+            let v = spec
+                .to_variable(name, nominal, positive)
+                .map_err(|e| err(format!("uncertainty.\"{name}\""), e))?;
+            variables.push(v);
         }
         let mut pairs = Vec::new();
         for (a, row) in &self.correlation {
@@ -195,6 +218,12 @@ impl UncertaintyTable {
                     "allowed: a finite percent_per_hour; steps at_hours ≥ 0 with factor > 0",
                 ));
             }
+        }
+        if self.monte_carlo.is_some_and(|n| n < 100) {
+            return Err(err(
+                "uncertainty.monte_carlo".into(),
+                "allowed: at least 100 samples",
+            ));
         }
         if self.system_samples.is_some_and(|n| n < 100) {
             return Err(err(

@@ -1,0 +1,970 @@
+//! The chance that a buildability object stands (issue 24): `[uncertainty]` in a buildability
+//! spec, β and P_f of every layer count by FORM and of the print as a series system (the cap's
+//! implementation: [`crate::analysis::reliability::form_checks`] and
+//! [`crate::analysis::reliability::print_reliability`]), and a seeded Monte Carlo of the whole
+//! print that counts, for every layer count, the samples in which it fails.
+//!
+//! # Parameters
+//!
+//! γ (`material.specific_weight`), the time model's E₀ and Ė (`material.time.youngs_modulus`,
+//! `…_rate`), its uniaxial strength f₀ and ḟ (`material.time.compressive_strength`, `…_rate`)
+//! and the layer time T (`process.layer_time`, which moves every layer's age).
+//!
+//! # Exact reductions (docs/reliability.md, "Buildability")
+//!
+//! In a state with n layers the element of row k has the modulus E₀ + Ė·h(a_k) (h(a) = a for the
+//! linear law, t_c(e^{a/t_c} − 1) for the exponential one) with a_k the age of layer k. Without
+//! waits a_k = T·m_k, so for the linear law E_k = E₀(1 + ρ·a_k(T₀)) with the one shape
+//! parameter ρ = (Ė/E₀)(T/T₀); with T fixed ρ = Ė/E₀ for any law. The shell's stiffness is then
+//! E₀·K̂(ρ), its self-weight load and hence its geometric stiffness are proportional to γ, so
+//!
+//! BLF(x) = (E₀/E₀⁰)(γ₀/γ)·Λ(ρ),
+//!
+//! and its static stresses are (γ/γ₀)·σ̂(ρ) (the load is linear in γ; a uniform factor on the
+//! stiffness does not change the stresses). The Mohr–Coulomb demand of a membrane stress state
+//! is homogeneous of degree 1 in the stresses at a fixed friction angle, so layer k's strength
+//! utilisation is (γ/γ₀)·D_k(ρ)/(c_k·cos φ), with D_k the largest demand among its elements and
+//! c_k = f_c(a_k)·(1 − sin φ)/(2 cos φ) its cohesion at the sample's f₀, ḟ and T; with φ = 0 its
+//! bed-joint sliding utilisation is (γ/γ₀)·S_k(ρ)/c_k, S_k the largest |τ| of its joints.
+//!
+//! Λ, D_k and S_k are functions of the one variable ρ: each is interpolated by the polynomial
+//! through [`NODES`] Chebyshev points of ln ρ (barycentric form, Berrut & Trefethen 2004) spanning
+//! the ρ of every sample whose variables lie within ±[`Z_RANGE`] standard deviations; a sample
+//! outside that box, or a spec the reductions do not cover (waits with an uncertain T, a law other
+//! than linear with an uncertain T, a modulus cap, a Mohr–Coulomb c(t), φ(t) strength or sliding
+//! with φ ≠ 0) is evaluated by a re-solve of the state ([`crate::commands::buildability::
+//! check_layers`], the deterministic check itself). [`Surrogate::verify`] compares the two.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use kappe_reliability::{
+    Batch, EvalError, Fallible, FormResult, Model, SamplingOptions, SamplingResult, SystemOptions,
+    merge_events, sample_events,
+};
+
+use crate::analysis::green::{
+    BucklingOutcome, GreenOptions, ModeStart, bed_traction, principal, solve_state,
+};
+use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
+use crate::commands::buildability::{Resolved, check_layers, object_shell};
+use crate::input::error::DesignError;
+use crate::input::material::{MohrCoulomb, Strength, TimeLaw, TimeModel};
+use crate::input::uncertainty::{BETA_MIN_DEFAULT, UncertaintyTable};
+
+/// The names a buildability spec's `[uncertainty]` accepts and whether each is positive.
+pub const PARAMETERS: [(&str, bool); 6] = [
+    ("material.specific_weight", false),
+    ("material.time.youngs_modulus", true),
+    ("material.time.youngs_modulus_rate", true),
+    ("material.time.compressive_strength", true),
+    ("material.time.compressive_strength_rate", true),
+    ("process.layer_time", true),
+];
+
+/// Chebyshev points of ln ρ per state: the interpolation error of the smooth Λ(ρ) and D_k(ρ)
+/// over the range falls geometrically with their number; 9 keep it below 1e-4 relative on the
+/// Wolfs cylinder ([`Surrogate::verify`], `cargo run --release -p kappe --example
+/// buildability_mc`).
+pub const NODES: usize = 9;
+
+/// Half-width of the box of variables the interpolation covers, in standard deviations of each
+/// variable: P(|z| > 5) = 5.7e-7 per normal number, so 10⁴ samples of 3 variables fall outside
+/// with probability ≈ 2 %, and such a sample is re-solved exactly, not extrapolated.
+pub const Z_RANGE: f64 = 5.0;
+
+const GAMMA: usize = 0;
+const E0: usize = 1;
+const RATE: usize = 2;
+const F0: usize = 3;
+const FRATE: usize = 4;
+const T: usize = 5;
+
+/// Nominal values of the six parameters, in [`PARAMETERS`] order.
+fn nominal(r: &Resolved) -> [f64; 6] {
+    let (f0, fr) = match r.time.strength {
+        Some(Strength::Uniaxial {
+            compressive_strength: p,
+            ..
+        }) => (p.initial, p.rate),
+        _ => (f64::NAN, f64::NAN),
+    };
+    [
+        r.spec.material.specific_weight,
+        r.time.youngs_modulus.initial,
+        r.time.youngs_modulus.rate,
+        f0,
+        fr,
+        r.layer_time,
+    ]
+}
+
+fn uerr(field: impl Into<String>, message: impl Into<String>) -> DesignError {
+    DesignError::Uncertainty {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// The uncertain model of a buildability spec and where each parameter sits in it.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// The random variables.
+    pub model: Model,
+    /// Their drifts over print time.
+    pub drifts: Vec<(String, kappe_reliability::Drift)>,
+    /// `idx[p]`: the model index of parameter p ([`PARAMETERS`] order), if uncertain.
+    pub idx: [Option<usize>; 6],
+    /// Nominal values.
+    pub nominal: [f64; 6],
+}
+
+impl Prepared {
+    /// The six parameters at the model point x (nominal where not uncertain).
+    pub fn params(&self, x: &[f64]) -> [f64; 6] {
+        std::array::from_fn(|p| {
+            self.idx[p]
+                .and_then(|i| x.get(i).copied())
+                .unwrap_or(self.nominal[p])
+        })
+    }
+}
+
+/// The model of `table` for the spec `r`; named errors for unknown names, a strength
+/// parameter without a uniaxial strength model, and the rest of [`UncertaintyTable::model_with`].
+///
+/// # Errors
+/// [`DesignError::Uncertainty`] naming the field.
+pub fn prepare(r: &Resolved, table: &UncertaintyTable) -> Result<Prepared, DesignError> {
+    let nom = nominal(r);
+    let allowed = PARAMETERS
+        .iter()
+        .map(|(n, _)| format!("\"{n}\""))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let model = table.model_with(&|name: &str| {
+        let Some(p) = PARAMETERS.iter().position(|(n, _)| *n == name) else {
+            return Err(format!(
+                "unknown parameter of a buildability spec; allowed names: {allowed}"
+            ));
+        };
+        if nom[p].is_nan() {
+            return Err(
+                "a strength parameter needs the uniaxial strength model: give \
+                        compressive_strength (and compressive_strength_rate) in [material.time]"
+                    .to_owned(),
+            );
+        }
+        Ok((nom[p], PARAMETERS[p].1))
+    })?;
+    let idx = std::array::from_fn(|p| {
+        model
+            .variables()
+            .iter()
+            .position(|v| v.name == PARAMETERS[p].0)
+    });
+    Ok(Prepared {
+        model,
+        drifts: table.drifts(),
+        idx,
+        nominal: nom,
+    })
+}
+
+/// The spec at parameters `p` (time model, γ and layer time replaced), resolved again.
+///
+/// # Errors
+/// A parameter the spec's checks refuse (e.g. a layer time ≤ 0).
+pub fn resolved_at(r: &Resolved, p: &[f64; 6]) -> Result<Resolved, DesignError> {
+    let mut spec = r.spec.clone();
+    spec.uncertainty = None;
+    spec.material.specific_weight = p[GAMMA];
+    if p[T] != r.layer_time {
+        spec.process.layer_time = Some(p[T]);
+        spec.process.print_speed = None;
+    }
+    let mut out = spec.resolve()?;
+    out.time = time_at(&r.time, p);
+    Ok(out)
+}
+
+fn time_at(time: &TimeModel, p: &[f64; 6]) -> TimeModel {
+    let mut t = time.clone();
+    t.youngs_modulus.initial = p[E0];
+    t.youngs_modulus.rate = p[RATE];
+    if let Some(Strength::Uniaxial {
+        compressive_strength,
+        ..
+    }) = &mut t.strength
+    {
+        compressive_strength.initial = p[F0];
+        compressive_strength.rate = p[FRATE];
+    }
+    t
+}
+
+/// BLF (None: not checked or none), strength and sliding utilisations of one state.
+pub type StateValues = (Option<f64>, Option<f64>, Option<f64>);
+
+/// One state's values by a re-solve at parameters `p` (the deterministic check itself).
+///
+/// # Errors
+/// A failed solve or a refused parameter.
+pub fn exact_state(r: &Resolved, n: usize, p: &[f64; 6]) -> Result<StateValues, DesignError> {
+    let s = check_layers(&resolved_at(r, p)?, n)?;
+    Ok((s.blf, s.strength_utilisation, s.sliding_utilisation))
+}
+
+/// Barycentric weights of the Chebyshev points of the first kind (Berrut & Trefethen 2004, (5.3)).
+fn cheb(lo: f64, hi: f64, k: usize) -> (Vec<f64>, Vec<f64>) {
+    let pi = std::f64::consts::PI;
+    let nodes = (0..k)
+        .map(|j| {
+            let t = ((2 * j + 1) as f64 * pi / (2 * k) as f64).cos();
+            0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+        })
+        .collect();
+    let weights = (0..k)
+        .map(|j| {
+            let th = (2 * j + 1) as f64 * pi / (2 * k) as f64;
+            let s = if j % 2 == 0 { 1.0 } else { -1.0 };
+            s * th.sin()
+        })
+        .collect();
+    (nodes, weights)
+}
+
+/// Coefficients c_j of the interpolant at s: f(s) = Σ c_j f_j.
+fn bary(nodes: &[f64], weights: &[f64], s: f64, out: &mut [f64]) {
+    if let Some(j) = nodes.iter().position(|&x| x == s) {
+        out.iter_mut().for_each(|c| *c = 0.0);
+        out[j] = 1.0;
+        return;
+    }
+    let mut sum = 0.0;
+    for ((c, &x), &w) in out.iter_mut().zip(nodes).zip(weights) {
+        *c = w / (s - x);
+        sum += *c;
+    }
+    out.iter_mut().for_each(|c| *c /= sum);
+}
+
+/// One layer count's tables at the interpolation points.
+#[derive(Debug, Clone)]
+struct StateTable {
+    /// ln Λ per point (None: no buckling check, or a point without a positive factor).
+    log_blf: Option<Vec<f64>>,
+    /// D_k per point (row-major: point j, layer k).
+    strength: Option<Vec<f64>>,
+    /// S_k per point.
+    sliding: Option<Vec<f64>>,
+    /// Ages of the layers at the nominal T, s.
+    ages: Vec<f64>,
+    /// A point without a positive buckling factor: the state is re-solved at every sample.
+    exact: bool,
+}
+
+/// The interpolated state values of a buildability spec; see the module docs.
+#[derive(Debug)]
+pub struct Surrogate {
+    /// The uncertain model.
+    pub prepared: Prepared,
+    /// ln ρ of the points (empty: ρ does not vary, one table per state at the nominal ρ).
+    nodes: Vec<f64>,
+    weights: Vec<f64>,
+    /// [ln ρ_lo, ln ρ_hi] covered.
+    range: [f64; 2],
+    /// Whether ρ scales with T (an uncertain T reduces exactly).
+    t_scales: bool,
+    /// Whether the reductions hold (else every evaluation is a re-solve).
+    pub reducible: bool,
+    /// Per layer count n (index n − 1).
+    states: Vec<StateTable>,
+    sin_phi: f64,
+    cos_phi: f64,
+    /// Re-solves done for samples outside the box.
+    pub fallbacks: std::sync::atomic::AtomicU64,
+    /// Wall-clock seconds of building the tables.
+    pub build_seconds: f64,
+}
+
+/// Print time of the state with n layers, h.
+fn t_hours(r: &Resolved, n: usize) -> f64 {
+    r.schedule
+        .layers
+        .get(n.saturating_sub(1))
+        .map_or(0.0, |l| l.end_s)
+        / 3600.0
+}
+
+impl Surrogate {
+    /// The tables of every layer count 1..=`max_layers` (states in parallel, the points of one
+    /// state in sequence, each eigensolve started from the previous point's mode).
+    ///
+    /// # Errors
+    /// A failed solve, or a drift factor that is not positive within the print.
+    pub fn build(r: &Resolved, prepared: Prepared) -> Result<Surrogate, DesignError> {
+        let t0 = kappe_fe::clock::Instant::now();
+        let nom = prepared.nominal;
+        let time = &r.time;
+        let c = &r.spec.checks;
+        let t_unc = prepared.idx[T].is_some();
+        let no_waits = r.schedule.total_wait_s() == 0.0;
+        let t_scales = t_unc && no_waits && time.law == TimeLaw::Linear;
+        let (phi, uniaxial) = match time.strength {
+            Some(Strength::Uniaxial {
+                friction_angle_deg, ..
+            }) => (friction_angle_deg.to_radians(), true),
+            Some(Strength::MohrCoulomb { .. }) => (0.0, false),
+            None => (0.0, true),
+        };
+        let stress = (c.strength || c.sliding) && time.strength.is_some();
+        let reducible = time.youngs_modulus.max.is_none()
+            && (!t_unc || t_scales)
+            && (uniaxial || !stress)
+            && (!(c.sliding && stress) || phi == 0.0)
+            && r.spec.nonlinear().is_none()
+            && nom[E0] > 0.0;
+        let max = r.spec.object.max_layers;
+        // The box of every state's (drifted) variables.
+        let (mut lo, mut hi) = ([f64::INFINITY; 6], [f64::NEG_INFINITY; 6]);
+        for n in 1..=max {
+            let m = prepared
+                .model
+                .drifted(&prepared.drifts, t_hours(r, n))
+                .map_err(|e| uerr("uncertainty.drift", format!("state {n}: {e}")))?;
+            for p in 0..6 {
+                let (a, b) = match prepared.idx[p].and_then(|i| m.variables().get(i)) {
+                    Some(v) => (
+                        v.distribution.from_standard(-Z_RANGE),
+                        v.distribution.from_standard(Z_RANGE),
+                    ),
+                    None => (nom[p], nom[p]),
+                };
+                lo[p] = lo[p].min(a);
+                hi[p] = hi[p].max(b);
+            }
+        }
+        let tf = |t: f64| if t_scales { t / nom[T] } else { 1.0 };
+        let rho_lo = lo[RATE] / hi[E0] * tf(lo[T]);
+        let rho_hi = hi[RATE] / lo[E0] * tf(hi[T]);
+        let varies = nom[RATE] > 0.0 && rho_lo > 0.0 && rho_hi > rho_lo;
+        let range = if varies {
+            [rho_lo.ln(), rho_hi.ln()]
+        } else {
+            [f64::NAN; 2]
+        };
+        let (nodes, weights) = if varies {
+            cheb(range[0], range[1], NODES)
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let rhos: Vec<f64> = if varies {
+            nodes.iter().map(|s| s.exp()).collect()
+        } else {
+            vec![nom[RATE] / nom[E0]]
+        };
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let states = if reducible {
+            (1..=max)
+                .into_par_iter()
+                .map(|n| state_table(r, n, &rhos, phi, stress))
+                .collect::<Result<Vec<_>, _>>()?
+        } else {
+            Vec::new()
+        };
+        Ok(Surrogate {
+            prepared,
+            nodes,
+            weights,
+            range,
+            t_scales,
+            reducible,
+            states,
+            sin_phi,
+            cos_phi,
+            fallbacks: std::sync::atomic::AtomicU64::new(0),
+            build_seconds: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The values of the state with `n` layers at parameters `p` ([`PARAMETERS`] order): from
+    /// the tables where the reductions hold, else by a re-solve.
+    ///
+    /// # Errors
+    /// A failed re-solve.
+    pub fn state(&self, r: &Resolved, n: usize, p: &[f64; 6]) -> Result<StateValues, DesignError> {
+        self.state_with(r, n, p, false)
+    }
+
+    /// [`Surrogate::state`], but with ρ outside the box clamped to its edge instead of a
+    /// re-solve (`clamp`): for FORM, whose iterates may wander far out. A point outside the box
+    /// has some |zᵢ| > [`Z_RANGE`], so a design point there has β > 5 (P_f < 3·10⁻⁷); its β is
+    /// then approximate (the shape ρ held at the edge, the exact scalings in E₀, γ, f₀, ḟ, T
+    /// still applied).
+    ///
+    /// # Errors
+    /// A failed re-solve.
+    pub fn state_with(
+        &self,
+        r: &Resolved,
+        n: usize,
+        p: &[f64; 6],
+        clamp: bool,
+    ) -> Result<StateValues, DesignError> {
+        self.state_layers(r, n, p, clamp, None)
+    }
+
+    /// [`Surrogate::state_with`] with the strength and sliding of layer `layer` only (None:
+    /// the worst layer).
+    ///
+    /// # Errors
+    /// A failed re-solve.
+    pub fn state_layers(
+        &self,
+        r: &Resolved,
+        n: usize,
+        p: &[f64; 6],
+        clamp: bool,
+        layer: Option<usize>,
+    ) -> Result<StateValues, DesignError> {
+        let nom = &self.prepared.nominal;
+        let table = match self.states.get(n.wrapping_sub(1)) {
+            Some(t) if self.reducible && !t.exact => t,
+            _ => return exact_state(r, n, p),
+        };
+        let k = self.nodes.len().max(1);
+        let mut coef = [0.0; NODES];
+        let coef = &mut coef[..k];
+        if self.nodes.is_empty() {
+            coef[0] = 1.0;
+        } else {
+            let tf = if self.t_scales { p[T] / nom[T] } else { 1.0 };
+            let rho = p[RATE] / p[E0] * tf;
+            let s = rho.ln();
+            let [lo, hi] = self.range;
+            if clamp && s.is_finite() && !(lo..=hi).contains(&s) {
+                // Outside the box, for FORM only: the tables (all logarithms) continued as
+                // straight lines in ln ρ from the edge (C¹, power laws), so that FORM's far
+                // iterates see a smooth surface.
+                let (e, inner) = if s < lo {
+                    (lo, lo + 1e-3 * (hi - lo))
+                } else {
+                    (hi, hi - 1e-3 * (hi - lo))
+                };
+                let mut ce = [0.0; NODES];
+                let mut ci = [0.0; NODES];
+                bary(&self.nodes, &self.weights, e, &mut ce[..k]);
+                bary(&self.nodes, &self.weights, inner, &mut ci[..k]);
+                let t = (s - e) / (e - inner);
+                for j in 0..k {
+                    coef[j] = ce[j] + (ce[j] - ci[j]) * t;
+                }
+            } else if !(s >= lo && s <= hi) {
+                self.fallbacks
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                return exact_state(r, n, p);
+            } else {
+                bary(&self.nodes, &self.weights, s, coef);
+            }
+        }
+        let at = |v: &[f64], stride: usize, i: usize| -> f64 {
+            coef.iter()
+                .enumerate()
+                .map(|(j, c)| c * v.get(j * stride + i).copied().unwrap_or(0.0))
+                .sum()
+        };
+        let rg = p[GAMMA] / nom[GAMMA];
+        let blf = table
+            .log_blf
+            .as_ref()
+            .map(|l| at(l, 1, 0).exp() * (p[E0] / nom[E0]) / rg);
+        let time = time_at(&r.time, p);
+        let scale_t = if self.t_scales { p[T] / nom[T] } else { 1.0 };
+        let layers = table.ages.len();
+        let worst = |v: &Option<Vec<f64>>, capacity: &dyn Fn(&MohrCoulomb) -> f64| {
+            v.as_ref().map(|v| {
+                let range = match layer {
+                    Some(l) => l.min(layers)..(l + 1).min(layers),
+                    None => 0..layers,
+                };
+                range.fold(0.0_f64, |m, kl| {
+                    let age = table.ages.get(kl).copied().unwrap_or(0.0) * scale_t;
+                    let d = rg * at(v, layers, kl).exp();
+                    let u = match time.mohr_coulomb(age) {
+                        Some(mc) if capacity(&mc) > 0.0 => d / capacity(&mc),
+                        _ if d > 0.0 => f64::INFINITY,
+                        _ => 0.0,
+                    };
+                    m.max(u)
+                })
+            })
+        };
+        let cos_phi = self.cos_phi;
+        let _ = self.sin_phi;
+        let strength = worst(&table.strength, &|mc| mc.cohesion * cos_phi);
+        let sliding = worst(&table.sliding, &|mc| mc.cohesion);
+        Ok((blf, strength, sliding))
+    }
+
+    /// The largest relative differences (BLF, strength, sliding) between the tables and
+    /// re-solves at `points` parameter sets of the model (drawn by the model's own seeded
+    /// Monte Carlo stream `seed`, every `stride`-th layer count).
+    ///
+    /// # Errors
+    /// A failed solve.
+    pub fn verify(
+        &self,
+        r: &Resolved,
+        points: u64,
+        seed: u64,
+        stride: usize,
+    ) -> Result<[f64; 3], DesignError> {
+        let mut worst = [0.0_f64; 3];
+        let m = &self.prepared.model;
+        let mut xs = Vec::new();
+        let collect = std::sync::Mutex::new(&mut xs);
+        sample_events(
+            m,
+            0,
+            &|_u: &[f64], x: &[f64], _h: &mut [bool]| {
+                if let Ok(mut g) = collect.lock() {
+                    g.push(x.to_vec());
+                }
+                Ok(())
+            },
+            &SamplingOptions::new(points.max(2), seed),
+            Batch { index: 0, count: 1 },
+        )
+        .map_err(|e| uerr("uncertainty", e.to_string()))?;
+        let stride = stride.max(1);
+        let max = r.spec.object.max_layers;
+        let pairs: Vec<(usize, Vec<f64>)> = xs
+            .iter()
+            .flat_map(|x| (1..=max).step_by(stride).map(move |n| (n, x.clone())))
+            .collect();
+        let diffs = pairs
+            .par_iter()
+            .map(|(n, x)| {
+                let p = self.prepared.params(x);
+                let a = self.state(r, *n, &p)?;
+                let b = exact_state(r, *n, &p)?;
+                let rel = |a: Option<f64>, b: Option<f64>| match (a, b) {
+                    (Some(a), Some(b)) if b.abs() > 0.0 && b.is_finite() => ((a - b) / b).abs(),
+                    _ => 0.0,
+                };
+                Ok([rel(a.0, b.0), rel(a.1, b.1), rel(a.2, b.2)])
+            })
+            .collect::<Result<Vec<_>, DesignError>>()?;
+        for d in diffs {
+            for k in 0..3 {
+                worst[k] = worst[k].max(d[k]);
+            }
+        }
+        Ok(worst)
+    }
+}
+
+/// One state's tables at the points `rhos` (see [`StateTable`]).
+fn state_table(
+    r: &Resolved,
+    n: usize,
+    rhos: &[f64],
+    phi: f64,
+    stress: bool,
+) -> Result<StateTable, DesignError> {
+    let (mut model, layers) = object_shell(r, n);
+    let ages = r.schedule.ages(n);
+    let c = &r.spec.checks;
+    let opts = GreenOptions {
+        blf_min: c.blf_min,
+        buckling: c.buckling,
+        strength: c.strength,
+        sliding: c.sliding,
+        ..Default::default()
+    };
+    // A unit capacity: `utilisation` then returns the Mohr–Coulomb demand itself.
+    let unit = MohrCoulomb {
+        cohesion: 1.0 / phi.cos(),
+        friction_angle: phi,
+    };
+    let mut log_blf = c.buckling.then(Vec::new);
+    let mut strength = (stress && c.strength).then(Vec::new);
+    let mut sliding = (stress && c.sliding).then(Vec::new);
+    let mut start: Option<ModeStart> = None;
+    for &rho in rhos {
+        let mut time = r.time.clone();
+        time.youngs_modulus.rate = rho * r.time.youngs_modulus.initial;
+        let (b, st, mode) = solve_state(
+            &mut model,
+            &layers,
+            &ages,
+            &time,
+            &opts,
+            start.take(),
+            stress,
+        )?;
+        start = mode;
+        if let Some(l) = log_blf.as_mut() {
+            match b {
+                BucklingOutcome::Factor { blf } if blf > 0.0 => l.push(blf.ln()),
+                // A point without a positive factor: this state is re-solved instead.
+                _ => {
+                    return Ok(StateTable {
+                        log_blf: None,
+                        strength: None,
+                        sliding: None,
+                        ages: Vec::new(),
+                        exact: true,
+                    });
+                }
+            }
+        }
+        let (mut d, mut sl) = (vec![0.0_f64; n], vec![0.0_f64; n]);
+        if let Some(st) = &st {
+            for (res, info) in st.elements.iter().zip(&layers) {
+                let [sx, sy, sxy] = res.membrane_stress();
+                let k = info.younger.min(n - 1);
+                let (s1, s2) = principal(sx, sy, sxy);
+                d[k] = d[k].max(unit.utilisation(s1, s2));
+                let (_, tau) = bed_traction(&res.frame, [sx, sy, sxy], info.bed_normal);
+                sl[k] = sl[k].max(tau.abs());
+            }
+        }
+        // Logarithms (floored at 1e-12 of the state's largest, so that a layer without
+        // stress stays finite): interpolated and continued in log–log.
+        for (v, x) in [(strength.as_mut(), d), (sliding.as_mut(), sl)] {
+            if let Some(v) = v {
+                let top = x.iter().copied().fold(0.0_f64, f64::max);
+                let floor = (1e-12 * top).max(f64::MIN_POSITIVE);
+                v.extend(x.iter().map(|y| y.max(floor).ln()));
+            }
+        }
+    }
+    Ok(StateTable {
+        log_blf,
+        strength,
+        sliding,
+        ages,
+        exact: false,
+    })
+}
+
+/// The crude Monte Carlo of a buildability print (`[uncertainty] monte_carlo = N`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PrintMonteCarlo {
+    /// Samples N.
+    pub samples: u64,
+    /// Seed.
+    pub seed: u64,
+    /// P_f of the print (some layer count up to `max_layers` fails), its 95 % (Wilson)
+    /// interval and β.
+    pub pf: f64,
+    /// 95 % interval of `pf`.
+    pub pf_interval: [f64; 2],
+    /// β = −Φ⁻¹(P_f).
+    pub beta: f64,
+    /// Per layer count n = 1, 2, …: P(state n fails) and its 95 % interval.
+    pub state_pf: Vec<[f64; 3]>,
+    /// Per layer count n: P(the print has failed by layer n).
+    pub failed_by: Vec<f64>,
+    /// Mean and standard deviation of the failure layer among the samples that fail.
+    pub failure_layer_mean: Option<f64>,
+    /// Standard deviation of the failure layer.
+    pub failure_layer_std: Option<f64>,
+    /// Samples evaluated by a re-solve (outside the tables' box).
+    pub resolves: u64,
+    /// Wall-clock seconds of the tables and of the sampling.
+    pub seconds: [f64; 2],
+}
+
+/// Whether the state fails at these values (the deterministic verdict's rules).
+fn fails(v: StateValues, blf_min: f64) -> bool {
+    v.0.is_some_and(|b| b < blf_min) || v.1.is_some_and(|u| u > 1.0) || v.2.is_some_and(|u| u > 1.0)
+}
+
+/// Batch `batch` of the print's Monte Carlo: 2N events per sample, "state n fails" (0 ≤ n − 1
+/// < N) and "failed by layer n" (N + n − 1), each state at its print time's drifted variables
+/// (the same u for every state: the same batch of concrete drifting).
+///
+/// # Errors
+/// A drift factor that is not positive, or a failed re-solve.
+pub fn monte_carlo_batch(
+    r: &Resolved,
+    sur: &Surrogate,
+    options: &SamplingOptions,
+    batch: Batch,
+) -> Result<kappe_reliability::EventBatch, DesignError> {
+    let max = r.spec.object.max_layers;
+    let p = &sur.prepared;
+    let models = (1..=max)
+        .map(|n| {
+            if p.drifts.is_empty() {
+                Ok(None)
+            } else {
+                p.model
+                    .drifted(&p.drifts, t_hours(r, n))
+                    .map(Some)
+                    .map_err(|e| uerr("uncertainty.drift", format!("state {n}: {e}")))
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let blf_min = r.spec.checks.blf_min;
+    let indicator = |u: &[f64], x: &[f64], hits: &mut [bool]| -> Result<(), EvalError> {
+        let mut failed = false;
+        for n in 1..=max {
+            let xn = match models.get(n - 1) {
+                Some(Some(m)) => m.x_from_u(u),
+                _ => x.to_vec(),
+            };
+            let v = sur
+                .state(r, n, &p.params(&xn))
+                .map_err(|e| EvalError::from(e.to_string()))?;
+            if fails(v, blf_min) {
+                hits[n - 1] = true;
+                failed = true;
+            }
+            if failed {
+                hits[max + n - 1] = true;
+            }
+        }
+        Ok(())
+    };
+    sample_events(&p.model, 2 * max, &indicator, options, batch)
+        .map_err(|e| uerr("uncertainty", format!("Monte Carlo: {e}")))
+}
+
+/// The print's Monte Carlo from its merged batches.
+///
+/// # Errors
+/// Batches that do not make up one run.
+pub fn monte_carlo_result(
+    batches: &[kappe_reliability::EventBatch],
+    resolves: u64,
+    seconds: [f64; 2],
+) -> Result<PrintMonteCarlo, DesignError> {
+    let res: Vec<SamplingResult> =
+        merge_events(batches).map_err(|e| uerr("uncertainty", e.to_string()))?;
+    let max = res.len() / 2;
+    let (Some(first), Some(last)) = (batches.first(), res.last()) else {
+        return Err(uerr("uncertainty", "Monte Carlo: no batches"));
+    };
+    let failed_by: Vec<f64> = res.iter().skip(max).map(|s| s.pf).collect();
+    let total = failed_by.last().copied().unwrap_or(0.0);
+    let (mut m1, mut m2, mut prev) = (0.0, 0.0, 0.0);
+    for (k, f) in failed_by.iter().enumerate() {
+        let pk = f - prev;
+        prev = *f;
+        let n = (k + 1) as f64;
+        m1 += pk * n;
+        m2 += pk * n * n;
+    }
+    let (mean, std) = if total > 0.0 {
+        let mean = m1 / total;
+        (Some(mean), Some((m2 / total - mean * mean).max(0.0).sqrt()))
+    } else {
+        (None, None)
+    };
+    Ok(PrintMonteCarlo {
+        samples: first.options.samples,
+        seed: first.options.seed,
+        pf: last.pf,
+        pf_interval: last.interval,
+        beta: last.beta,
+        state_pf: res
+            .iter()
+            .take(max)
+            .map(|s| [s.pf, s.interval[0], s.interval[1]])
+            .collect(),
+        failed_by,
+        failure_layer_mean: mean,
+        failure_layer_std: std,
+        resolves,
+        seconds,
+    })
+}
+
+/// The print's Monte Carlo in one process (every block in parallel).
+///
+/// # Errors
+/// See [`monte_carlo_batch`].
+pub fn monte_carlo(
+    r: &Resolved,
+    sur: &Surrogate,
+    samples: u64,
+    seed: u64,
+) -> Result<PrintMonteCarlo, DesignError> {
+    let t0 = kappe_fe::clock::Instant::now();
+    let before = sur.fallbacks.load(std::sync::atomic::Ordering::Relaxed);
+    let b = monte_carlo_batch(
+        r,
+        sur,
+        &SamplingOptions::new(samples, seed),
+        Batch { index: 0, count: 1 },
+    )?;
+    let after = sur.fallbacks.load(std::sync::atomic::Ordering::Relaxed);
+    monte_carlo_result(
+        &[b],
+        after - before,
+        [sur.build_seconds, t0.elapsed().as_secs_f64()],
+    )
+}
+
+/// Which checks of a state the random variables enter: buckling when γ, E₀, Ė or T is
+/// uncertain; strength and sliding when any is (the stresses scale with γ and change with ρ,
+/// the capacities with f₀, ḟ and T).
+fn random_checks(p: &Prepared, v: StateValues) -> Vec<&'static str> {
+    let any = p.idx.iter().any(Option::is_some);
+    let stiff = [GAMMA, E0, RATE, T].iter().any(|&k| p.idx[k].is_some());
+    let mut out = Vec::new();
+    if stiff && v.0.is_some_and(|b| b > 0.0) {
+        out.push("buckling");
+    }
+    if any && v.1.is_some_and(|u| u > 0.0) {
+        out.push("strength");
+    }
+    if any && v.2.is_some_and(|u| u > 0.0) {
+        out.push("sliding");
+    }
+    out
+}
+
+/// FORM of every check of the layer counts `states` (n, its deterministic values) and the
+/// print's series system; per state its [`StateReliability`] (index = n) and its check results.
+///
+/// # Errors
+/// A drift factor that is not positive, a failed re-solve, FORM that does not converge, or no
+/// random check at all.
+pub fn reliability(
+    r: &Resolved,
+    sur: &Surrogate,
+    states: &[(usize, StateValues)],
+    table: &UncertaintyTable,
+) -> Result<Reliability, DesignError> {
+    let t0 = kappe_fe::clock::Instant::now();
+    let p = &sur.prepared;
+    let blf_min = r.spec.checks.blf_min;
+    let seed = table.seed.unwrap_or(0);
+    type StateOut = Option<(StateReliability, Vec<(&'static str, FormResult)>)>;
+    let per_state: Vec<StateOut> = states
+        .par_iter()
+        .map(|&(n, v)| -> Result<StateOut, DesignError> {
+            let checks = random_checks(p, v);
+            if checks.is_empty() {
+                return Ok(None);
+            }
+            let th = t_hours(r, n);
+            let model = p
+                .model
+                .drifted(&p.drifts, th)
+                .map_err(|e| uerr("uncertainty.drift", format!("state {n} at {th:.3} h: {e}")))?;
+            // Buckling one component; strength and sliding one per layer (each layer's
+            // utilisation is smooth in the parameters, their maximum is not: the worst layer
+            // switches between the old bottom and the young top as f₀ and ḟ trade off, and
+            // HL-RF would zigzag on that kink). Only layers within a factor 5 of the state's
+            // worst nominal utilisation: a ln-margin 1.6 larger, about 16 standard deviations
+            // of a 10 % scatter, adds nothing to the state's P_f, and FORM far out (β ≫ 10)
+            // meets the round-off of its difference gradients.
+            let mut comps: Vec<(&'static str, Option<usize>)> = Vec::new();
+            for &name in &checks {
+                if name == "buckling" {
+                    comps.push((name, None));
+                    continue;
+                }
+                let pick = |v: StateValues| if name == "strength" { v.1 } else { v.2 };
+                let worst = pick(sur.state_layers(r, n, &p.nominal, true, None)?).unwrap_or(0.0);
+                for layer in 0..n {
+                    let u = pick(sur.state_layers(r, n, &p.nominal, true, Some(layer))?);
+                    if u.is_some_and(|u| u >= 0.2 * worst && u > 0.0 && u.is_finite()) {
+                        comps.push((name, Some(layer)));
+                    }
+                }
+            }
+            let named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = comps
+                .iter()
+                .map(|&(name, layer)| {
+                    let g = move |x: &[f64]| -> Result<f64, EvalError> {
+                        let v = sur
+                            .state_layers(r, n, &p.params(x), true, layer)
+                            .map_err(|e| EvalError::from(e.to_string()))?;
+                        // Logarithmic forms: the same failure surfaces as BLF − BLF_min and
+                        // 1 − u (so the same β), but nearly linear in u-space for the products
+                        // of powers the reductions give, which FORM needs far out (β ≫ 5).
+                        let val = match name {
+                            "buckling" => v.0.map(|b| (b / blf_min).ln()),
+                            "strength" => v.1.map(|u| -u.ln()),
+                            _ => v.2.map(|u| -u.ln()),
+                        };
+                        val.ok_or_else(|| {
+                            EvalError::from(format!("state {n}: no {name} value at x = {x:?}"))
+                        })
+                    };
+                    let b: Box<dyn kappe_reliability::LimitState + '_> = Box::new(Fallible(g));
+                    (name, b)
+                })
+                .collect();
+            form_checks(&model, named, n, th, seed)
+                .map(Some)
+                .map_err(|e| {
+                    uerr(
+                        "uncertainty",
+                        format!("state {n}: reliability analysis: {e}"),
+                    )
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut results = Vec::new();
+    let mut out = Vec::new();
+    for (s, rs) in per_state.into_iter().flatten() {
+        for (name, f) in rs {
+            results.push((s.index, name, f));
+        }
+        out.push(s);
+    }
+    if results.is_empty() {
+        return Err(uerr(
+            "uncertainty",
+            "no checked state depends on the uncertain parameters",
+        ));
+    }
+    print_reliability(
+        results,
+        out,
+        &SystemOptions {
+            samples: table.system_samples.unwrap_or(20_000),
+            seed,
+            ditlevsen: false,
+        },
+        BETA_MIN_DEFAULT,
+        t0,
+    )
+}
+
+/// FORM of every checked layer count and of the print, and the Monte Carlo when
+/// `[uncertainty] monte_carlo` asks for it: what [`crate::commands::buildability::run`] adds
+/// with `[uncertainty]`.
+///
+/// # Errors
+/// See [`Surrogate::build`], [`reliability`] and [`monte_carlo`].
+pub fn analyse(
+    r: &Resolved,
+    table: &UncertaintyTable,
+    states: &[crate::commands::buildability::BuildState],
+) -> Result<(Reliability, Option<PrintMonteCarlo>), DesignError> {
+    let sur = Surrogate::build(r, prepare(r, table)?)?;
+    let values: Vec<(usize, StateValues)> = states
+        .iter()
+        .map(|s| {
+            (
+                s.layers,
+                (s.blf, s.strength_utilisation, s.sliding_utilisation),
+            )
+        })
+        .collect();
+    let rel = reliability(r, &sur, &values, table)?;
+    let mc = match table.monte_carlo {
+        Some(n) => Some(monte_carlo(r, &sur, n, table.seed.unwrap_or(0))?),
+        None => None,
+    };
+    Ok((rel, mc))
+}
