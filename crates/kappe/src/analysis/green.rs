@@ -214,7 +214,7 @@ pub fn check_state(
     ))
 }
 
-/// The solves behind [`check_state_warm`]: the aged moduli set on `model` (each element the
+/// The solves behind [`check_state`]: the aged moduli set on `model` (each element the
 /// mean of its two layers' E), the buckling solve (when `options.buckling`) and the pre-buckling
 /// static solution (also without buckling when `want_stress`), and mode 1. Shared with the
 /// buildability reliability, which needs the whole stress field, not only the worst elements.

@@ -60,5 +60,5 @@ pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
-pub use reliability::{Check, Vars, check_form, limit_state};
+pub use reliability::{Check, Vars, check_form, limit_state, prepare, state_form};
 pub use shell::state_shell;

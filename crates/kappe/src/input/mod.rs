@@ -23,4 +23,4 @@ pub use analysis::AnalysisOptions;
 pub use design::EXAMPLE_TOML;
 pub use material::{TimeLaw, TimeModel, TimeModelSpec};
 pub use nonlinear::NonlinearSpec;
-pub use uncertainty::BETA_MIN_DEFAULT;
+pub use uncertainty::{BETA_MIN_DEFAULT, UncertaintyTable};

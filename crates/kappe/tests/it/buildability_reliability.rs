@@ -7,7 +7,7 @@ use kappe::commands::buildability_reliability::{
     PARAMETERS, Surrogate, exact_state, monte_carlo, monte_carlo_batch, monte_carlo_result,
     prepare, reliability,
 };
-use kappe::input::error::DesignError;
+use kappe::input::DesignError;
 use kappe_reliability::{Batch, SamplingOptions};
 
 /// The Wolfs cylinder with 24 segments and 12 layers (quick), its strength lowered to
@@ -34,7 +34,7 @@ const SCATTER: &str = r#"
 seed = 3
 "#;
 
-fn resolved(extra: &str) -> (Resolved, kappe::input::uncertainty::UncertaintyTable) {
+fn resolved(extra: &str) -> (Resolved, kappe::input::UncertaintyTable) {
     let mut spec = BuildabilitySpec::parse(&small(extra)).unwrap();
     let table = spec.uncertainty.take().unwrap_or_else(|| {
         let mut s = BuildabilitySpec::parse(&small(SCATTER)).unwrap();

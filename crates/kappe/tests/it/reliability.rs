@@ -422,8 +422,8 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
 /// in the Monte Carlo's 95 % (Wilson) interval.
 #[test]
 fn form_of_a_time_parameter_state_agrees_with_monte_carlo() {
-    use kappe::analysis::blf_sensitivity::time_state_blf;
-    use kappe::analysis::reliability::{prepare, state_form};
+    use kappe::analysis::time_state_blf;
+    use kappe::analysis::{prepare, state_form};
     let mut d = study14(None);
     let u = with_uncertainty(
         "[material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
@@ -432,8 +432,8 @@ fn form_of_a_time_parameter_state_agrees_with_monte_carlo() {
     )
     .unwrap();
     d.uncertainty = u.uncertainty;
-    let cap = design_cap(&d, &|_| {}).unwrap();
-    let green = kappe::analysis::green::CapGreen::new(&cap).unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
     let (model, drifts, v) = prepare(&cap).unwrap().unwrap();
     let q = cap.states.len() - 1;
     let t_hours = green.schedule.layers[q].end_s / 3600.0;
