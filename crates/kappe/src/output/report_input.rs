@@ -172,6 +172,47 @@ fn as_printed_plot(a: &crate::analysis::asprinted::AsPrinted, limit: Option<f64>
     }
 }
 
+/// The waves of a corrugated cap (issue 26): the crown height of every centre layer along the
+/// cap against the smooth cap's (layer 0's); `None` for a smooth cap. The 3D view shows the
+/// same waves and, per state, the buckling mode on them.
+fn corrugation_plot(cap: &Cap) -> Option<Plot> {
+    let crown = |a: &crate::form::arch::Arch| a.points.get(a.points.len() / 2).map(|p| p.z);
+    if cap.centre_arches.is_empty() {
+        return None;
+    }
+    let wave: Vec<[f64; 2]> = cap
+        .centre_arches
+        .iter()
+        .enumerate()
+        .filter_map(|(k, a)| crown(a).map(|z| [k as f64, 1e3 * z]))
+        .collect();
+    let smooth = crown(&cap.arch)?;
+    let last = (cap.centre_arches.len() - 1) as f64;
+    let w = cap.design.corrugation();
+    Some(Plot {
+        title: format!(
+            "Corrugation: crown height of each centre layer{}",
+            w.map_or(String::new(), |w| format!(
+                " (amplitude {:.1} mm, wavelength {:.3} m)",
+                1e3 * w.amplitude,
+                w.wavelength
+            ))
+        ),
+        x_label: "centre layer (print order)".into(),
+        y_label: "crown height in the layer's plane [mm]".into(),
+        series: vec![
+            Series {
+                name: "corrugated layers".into(),
+                points: wave,
+            },
+            Series {
+                name: "smooth cap (layer 0)".into(),
+                points: vec![[0.0, 1e3 * smooth], [last, 1e3 * smooth]],
+            },
+        ],
+    })
+}
+
 /// The governing collapse state's load–deflection curve (`[analysis.nonlinear]`): load factor
 /// against the largest displacement along the path.
 fn collapse_plot(analysis: &crate::analysis::Analysis) -> Option<Plot> {
@@ -669,7 +710,12 @@ pub fn report_input(cap: &Cap, extras: &ReportExtras) -> ReportInput {
         states,
         constraints: constraint_rows(cap, extras),
         robot: extras.robot.clone(),
-        plots: extras.plots.clone(),
+        plots: extras
+            .plots
+            .iter()
+            .cloned()
+            .chain(corrugation_plot(cap))
+            .collect(),
         timeline: Some(timeline(cap, extras)),
         cell: extras.cell.clone(),
         modes: mode_shapes(cap, extras),
@@ -1025,6 +1071,40 @@ mod tests {
             crate::Design::from_toml_str("[cap]\nlength = 0.05\n[print]\nlayer_height = 0.015\n")
                 .unwrap();
         crate::design_cap(&design, crate::Context::default()).unwrap()
+    }
+
+    #[test]
+    fn a_corrugated_cap_has_its_wave_plot_and_a_smooth_one_none() {
+        assert!(corrugation_plot(&cheap_cap()).is_none());
+        let design = crate::Design::from_toml_str(
+            "[cap]\nlength = 0.2\n[print]\nlayer_height = 0.015\n[constraints]\n\
+             overhang_max = 0.05\n[cap.corrugation]\namplitude = 0.03\nwavelength = 0.15\n",
+        )
+        .unwrap();
+        let cap = crate::design_cap(&design, crate::Context::default()).unwrap();
+        let input = report_input(&cap, &ReportExtras::default());
+        input.validate().unwrap();
+        let plot = input
+            .plots
+            .iter()
+            .find(|p| p.title.starts_with("Corrugation"))
+            .expect("the wave plot");
+        let wave = &plot.series[0].points;
+        assert_eq!(wave.len(), cap.sections.n_centre);
+        // The crowns follow rise + a·sin(2π·y/λ) (a = 30 mm, λ = 0.15 m; crest at y = 37.5 mm,
+        // trough at 112.5 mm, both inside the 0.2 m centre section). Consecutive layers are
+        // lh / cos(tilt) ≤ 20 mm apart (tilts up to 41°), so a crown lies within 10 mm of each
+        // extreme: the spread is at least 2·30·cos(π·0.01/0.15) = 58.7 mm and at most 60 mm.
+        let (lo, hi) = wave
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+                (l.min(p[1]), h.max(p[1]))
+            });
+        assert!(
+            hi - lo >= 48.0 && hi - lo <= 60.0 + 1e-6,
+            "spread {} mm",
+            hi - lo
+        );
     }
 
     #[test]
