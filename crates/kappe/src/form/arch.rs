@@ -56,7 +56,7 @@ impl Catenary {
     ///
     /// ```
     /// // method.md §4: defaults give a = 0.394642 m and 10.03 / 15.65 kPa.
-    /// let c = kappe::form::arch::Catenary::new(0.8, 0.2, 25f64.to_radians(), 23044.0);
+    /// let c = kappe::form::Catenary::new(0.8, 0.2, 25f64.to_radians(), 23044.0);
     /// assert!((c.a - 0.394642).abs() < 1e-6);
     /// assert!((c.crown_stress / 1e3 - 10.03).abs() < 0.01);
     /// assert!((c.springing_stress / 1e3 - 15.65).abs() < 0.01);

@@ -40,7 +40,7 @@ impl FromStr for StateSelection {
     /// Parse `"all"`, `"every:N"` or `"P%"`.
     ///
     /// ```
-    /// use kappe::input::analysis::StateSelection;
+    /// use kappe::analysis::StateSelection;
     /// assert_eq!("every:4".parse::<StateSelection>().unwrap(), StateSelection::Every(4));
     /// assert_eq!("25%".parse::<StateSelection>().unwrap(), StateSelection::Percent(25.0));
     /// assert!("every:0".parse::<StateSelection>().is_err());
