@@ -115,6 +115,20 @@ pub struct ChecksSpec {
     pub collapse_min: f64,
 }
 
+impl ChecksSpec {
+    /// The green-state check of one layer count with these checks (the deterministic check and
+    /// the reliability tables solve the same one).
+    pub fn green_options(&self) -> GreenOptions {
+        GreenOptions {
+            blf_min: self.blf_min,
+            buckling: self.buckling,
+            strength: self.strength,
+            sliding: self.sliding,
+            ..Default::default()
+        }
+    }
+}
+
 impl Default for ChecksSpec {
     fn default() -> Self {
         ChecksSpec {
@@ -556,13 +570,7 @@ pub fn check_layers_warm(
     let start = prev.and_then(|p| extend_mode(p, model.nodes.len(), cols));
     let ages = r.schedule.ages(n);
     let c = &r.spec.checks;
-    let opts = GreenOptions {
-        blf_min: c.blf_min,
-        buckling: c.buckling,
-        strength: c.strength,
-        sliding: c.sliding,
-        ..Default::default()
-    };
+    let opts = c.green_options();
     let (g, mode) = check_state(&mut model, &layers, &ages, &r.time, &opts, start)?;
     let o = &r.spec.object;
     let collapse = match (r.spec.nonlinear(), g.blf()) {

@@ -43,9 +43,7 @@ use kappe_reliability::{
     merge_events, sample_events,
 };
 
-use crate::analysis::green::{
-    BucklingOutcome, GreenOptions, ModeStart, bed_traction, principal, solve_state,
-};
+use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
 use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
 use crate::input::error::DesignError;
@@ -576,13 +574,7 @@ fn state_table(
     let (mut model, layers) = object_shell(r, n);
     let ages = r.schedule.ages(n);
     let c = &r.spec.checks;
-    let opts = GreenOptions {
-        blf_min: c.blf_min,
-        buckling: c.buckling,
-        strength: c.strength,
-        sliding: c.sliding,
-        ..Default::default()
-    };
+    let opts = c.green_options();
     // A unit capacity: `utilisation` then returns the Mohr–Coulomb demand itself.
     let unit = MohrCoulomb {
         cohesion: 1.0 / phi.cos(),
