@@ -233,6 +233,17 @@ fn center_of(method: &SamplingMethod) -> Option<&[f64]> {
     }
 }
 
+/// Block `b`'s random stream (the seed's stream number `b`, so every block draws the same numbers
+/// whichever batch or thread runs it) and its sample count (the last block may be short).
+fn block_stream(options: &SamplingOptions, b: u64) -> (ChaCha8Rng, u64) {
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    rng.set_stream(b);
+    let count = options
+        .block_size
+        .min(options.samples - b * options.block_size);
+    (rng, count)
+}
+
 /// The sums of block `b`: its own ChaCha8 stream, samples in order.
 fn run_block<L: LimitState + ?Sized>(
     model: &Model,
@@ -243,11 +254,7 @@ fn run_block<L: LimitState + ?Sized>(
 ) -> Result<BlockSums> {
     let half_c2 = center.map_or(0.0, |c| 0.5 * c.iter().map(|v| v * v).sum::<f64>());
     let mut u = vec![0.0; model.len()];
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    rng.set_stream(b);
-    let count = options
-        .block_size
-        .min(options.samples - b * options.block_size);
+    let (mut rng, count) = block_stream(options, b);
     let mut sums = BlockSums {
         block: b,
         samples: count,
@@ -446,11 +453,7 @@ where
         .into_par_iter()
         .map(|b| {
             let mut u = vec![0.0; model.len()];
-            let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-            rng.set_stream(b);
-            let count = options
-                .block_size
-                .min(options.samples - b * options.block_size);
+            let (mut rng, count) = block_stream(options, b);
             let mut counts = vec![0u64; events];
             let mut hits = vec![false; events];
             for _ in 0..count {
