@@ -19,8 +19,6 @@
 //! Everything compas_cem accepts silently but gets wrong (two supports on one chain,
 //! T-junctions, cycles, supports inside a trail) is a typed [`CemError`] here.
 
-use std::collections::HashMap;
-
 use nalgebra::Vector3;
 
 use crate::error::CemError;
@@ -104,6 +102,32 @@ pub struct Model {
 fn unit_f64(v: Vector3<f64>) -> Vector3<f64> {
     let n = v.norm();
     if n == 0.0 { v } else { v / n }
+}
+
+/// The steps in ascending sequence, trail order within a sequence (a stable sort by sequence):
+/// a counting sort when the sequences are dense (every model built from a topology without
+/// far-shifted trails), else the library's stable sort.
+fn by_sequence(steps: Vec<(usize, Step)>) -> Vec<Step> {
+    let len = steps.len();
+    let top = steps.iter().map(|(k, _)| *k).max().unwrap_or(0);
+    if top > 4 * len + 1024 {
+        let mut steps = steps;
+        steps.sort_by_key(|(k, _)| *k);
+        return steps.into_iter().map(|(_, s)| s).collect();
+    }
+    let mut start = vec![0usize; top + 2];
+    for (k, _) in &steps {
+        start[k + 1] += 1;
+    }
+    for k in 0..=top {
+        start[k + 1] += start[k];
+    }
+    let mut out: Vec<Option<Step>> = vec![None; len];
+    for (k, s) in steps {
+        out[start[k]] = Some(s);
+        start[k] += 1;
+    }
+    out.into_iter().flatten().collect()
 }
 
 impl Model {
@@ -292,16 +316,16 @@ impl Model {
         }
 
         // Sequences and shifts.
-        let mut trail_of_origin: HashMap<usize, usize> = HashMap::new();
+        let mut trail_of_origin: Vec<Option<usize>> = vec![None; n];
         for (k, t) in trails.iter().enumerate() {
             if let Some(&o) = t.nodes.first() {
-                trail_of_origin.insert(o, k);
+                trail_of_origin[o] = Some(k);
             }
         }
         let mut shifted = vec![false; trails.len()];
         for s in &topo.trail_shifts {
             let o = index.get(&s.origin).copied().unwrap_or(usize::MAX);
-            let Some(&k) = trail_of_origin.get(&o) else {
+            let Some(k) = trail_of_origin.get(o).copied().flatten() else {
                 return Err(CemError::ShiftNotOrigin { id: s.origin });
             };
             if shifted[k] {
@@ -399,8 +423,7 @@ impl Model {
                 steps.push((t.start + j, Step { node, out }));
             }
         }
-        steps.sort_by_key(|(k, _)| *k);
-        let steps = steps.into_iter().map(|(_, s)| s).collect();
+        let steps = by_sequence(steps);
 
         Ok(Self {
             name: topo.name.clone(),
@@ -474,5 +497,34 @@ impl Model {
             .iter()
             .map(|a| (self.ids[a.node], self.ids[a.aux]))
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// The counting sort equals the library's stable sort by sequence (ties keep their order),
+    /// for dense sequences and for far-shifted ones (the fallback), on seeded random inputs.
+    #[test]
+    fn by_sequence_is_a_stable_sort_by_sequence() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for spread in [8usize, 1 << 20] {
+            for _ in 0..200 {
+                let len = rng.random_range(0..60usize);
+                let steps: Vec<(usize, Step)> = (0..len)
+                    .map(|node| {
+                        let k = rng.random_range(0..spread);
+                        (k, Step { node, out: None })
+                    })
+                    .collect();
+                let mut expected = steps.clone();
+                expected.sort_by_key(|(k, _)| *k);
+                let got: Vec<usize> = by_sequence(steps).iter().map(|s| s.node).collect();
+                let want: Vec<usize> = expected.iter().map(|(_, s)| s.node).collect();
+                assert_eq!(got, want);
+            }
+        }
     }
 }

@@ -323,6 +323,32 @@ fn finite3(what: impl Fn() -> String, v: &Vector3<f64>) -> Result<(), CemError> 
     Ok(())
 }
 
+/// Whether two of `ends` (node index pairs, lower first, indices below `n`) join the same two
+/// nodes: bucket the pairs by their lower end, then mark the upper ends per bucket. O(n + edges).
+fn has_duplicate(n: usize, ends: &[(usize, usize)]) -> bool {
+    let mut start = vec![0usize; n + 1];
+    for &(a, _) in ends {
+        start[a + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut upper = vec![0usize; ends.len()];
+    for &(a, b) in ends {
+        upper[fill[a]] = b;
+        fill[a] += 1;
+    }
+    let mut seen = vec![usize::MAX; n];
+    (0..n).any(|a| {
+        upper[start[a]..start[a + 1]].iter().any(|&b| {
+            let again = seen[b] == a;
+            seen[b] = a;
+            again
+        })
+    })
+}
+
 /// Element-level checks shared by [`crate::TopologyBuilder::build`] and [`Model::new`].
 pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
     let mut index = IdIndex::with_capacity(topo.nodes.len());
@@ -337,28 +363,31 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
     // on error (this check runs on every solve).
     let mut pairs: Vec<((NodeId, NodeId), usize)> =
         Vec::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
+    // Node indices of every edge's ends, lower first: the linear-time duplicate check below.
+    let mut ends: Vec<(usize, usize)> = Vec::with_capacity(pairs.capacity());
     let check_pair = |pairs: &mut Vec<((NodeId, NodeId), usize)>,
+                      ends: &mut Vec<(usize, usize)>,
                       kind: &'static str,
                       u: NodeId,
                       v: NodeId|
      -> Result<(), CemError> {
-        for id in [u, v] {
-            if !index.contains_key(&id) {
-                return Err(CemError::UnknownNode {
-                    id,
-                    context: format!("{kind} edge ({u}, {v})"),
-                });
-            }
+        let mut at = [0usize; 2];
+        for (slot, id) in at.iter_mut().zip([u, v]) {
+            *slot = *index.get(&id).ok_or_else(|| CemError::UnknownNode {
+                id,
+                context: format!("{kind} edge ({u}, {v})"),
+            })?;
         }
         if u == v {
             return Err(CemError::SelfLoop { kind, u });
         }
         let k = pairs.len();
         pairs.push(((u.min(v), u.max(v)), k));
+        ends.push((at[0].min(at[1]), at[0].max(at[1])));
         Ok(())
     };
     for e in &topo.trail_edges {
-        check_pair(&mut pairs, "trail", e.u, e.v)?;
+        check_pair(&mut pairs, &mut ends, "trail", e.u, e.v)?;
         finite(|| format!("trail edge ({}, {}) length", e.u, e.v), e.length)?;
         if let Some(p) = &e.plane {
             finite3(
@@ -375,13 +404,17 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
         }
     }
     for e in &topo.deviation_edges {
-        check_pair(&mut pairs, "deviation", e.u, e.v)?;
+        check_pair(&mut pairs, &mut ends, "deviation", e.u, e.v)?;
         finite(
             || format!("deviation edge ({}, {}) force", e.u, e.v),
             e.force,
         )?;
     }
-    pairs.sort_unstable();
+    // The sort names the first duplicate in id order; it runs only when the linear check
+    // found one (sorting every solve's edges was a fifth of a cap's form-finding).
+    if has_duplicate(topo.nodes.len(), &ends) {
+        pairs.sort_unstable();
+    }
     if let Some(w) = pairs.windows(2).find(|w| w[0].0 == w[1].0) {
         let n_trail = topo.trail_edges.len();
         let describe = |k: usize| match k.checked_sub(n_trail) {
@@ -414,4 +447,65 @@ pub(crate) fn check_elements(topo: &Topology) -> Result<IdIndex, CemError> {
         }
     }
     Ok(index)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// The linear-time check agrees with a brute-force comparison of every two edges, on random
+    /// small graphs (seeded) where duplicates are common and on ones without any.
+    #[test]
+    fn linear_duplicate_check_agrees_with_brute_force() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut found = [0usize; 2];
+        for _ in 0..2000 {
+            let n = rng.random_range(2..12usize);
+            let m = rng.random_range(0..2 * n);
+            let ends: Vec<(usize, usize)> = (0..m)
+                .map(|_| {
+                    let a = rng.random_range(0..n);
+                    let b = (a + rng.random_range(1..n)) % n;
+                    (a.min(b), a.max(b))
+                })
+                .collect();
+            let brute = (0..m).any(|i| (i + 1..m).any(|j| ends[i] == ends[j]));
+            assert_eq!(has_duplicate(n, &ends), brute, "{ends:?}");
+            found[usize::from(brute)] += 1;
+        }
+        // Both outcomes occurred, so the comparison tested each.
+        assert!(found[0] > 100 && found[1] > 100, "{found:?}");
+    }
+
+    /// A trail edge and a deviation edge joining the same two nodes (given in either order)
+    /// are one duplicate, named with both edges; node ids far from dense (the hash-map part
+    /// of the index) behave the same.
+    #[test]
+    fn a_duplicate_edge_is_named_with_both_edges() {
+        for base in [0u64, 1 << 40] {
+            let t = TopologyBuilder::default()
+                .node(base, [0.0, 0.0, 0.0])
+                .node(base + 1, [1.0, 0.0, 0.0])
+                .node(base + 2, [2.0, 0.0, 0.0])
+                .support(base + 1)
+                .trail_edge(base, base + 1, -1.0)
+                .deviation_edge(base + 2, base, 1.0)
+                .deviation_edge(base + 1, base, 1.0)
+                .build();
+            match t {
+                Err(CemError::DuplicateEdge {
+                    u,
+                    v,
+                    first,
+                    second,
+                }) => {
+                    assert_eq!((u, v), (base, base + 1));
+                    assert_eq!(first, format!("trail edge ({base}, {})", base + 1));
+                    assert_eq!(second, format!("deviation edge ({}, {base})", base + 1));
+                }
+                other => panic!("expected a duplicate edge, got {other:?}"),
+            }
+        }
+    }
 }

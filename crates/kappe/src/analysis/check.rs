@@ -12,9 +12,7 @@ use super::buckling::{
     BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_printed,
     state_material_with,
 };
-use super::stress::{
-    STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
-};
+use super::stress::{STRESS_REL_TOL, StressExtremes};
 use crate::form::cap::Cap;
 use crate::form::states::build_state;
 use crate::input::analysis::AnalysisOptions;
@@ -804,47 +802,20 @@ fn assemble(
         top_layer: i32,
         green: Option<GreenChecks>,
     }
-    // Phase 1: every state's force pass and element stresses (cheap). Against an end wall the
-    // final state's force pass gives every state's extremes (`extremes_by_depth`: linear, not
-    // quadratic, in the bay length).
+    // Phase 1: every state's element stresses. A prismatic cap's come with its form
+    // (`StateSummary::stresses`, from the force pass `design_cap` ran anyway); a corrugated
+    // cap's add the shell's bending (`crate::analysis::bending`).
     let t_phase = Instant::now();
-    let by_depth = match total.checked_sub(1) {
-        // A corrugated cap's layers differ, so its forces are not a function of depth alone.
-        Some(last) if depth_invariant(&cap.sections) && cap.centre_arches.is_empty() => {
-            let state = build_state(&cap.sections, &cap.frame, phi, last)?;
-            extremes_by_depth(&cap.sections, &element_stresses(&state, areas)?)
-        }
-        _ => None,
-    };
-    let mut per: Vec<PerState> = if let Some(extremes) = by_depth {
-        let secs = t_phase.elapsed().as_secs_f64() / total.max(1) as f64;
-        extremes
-            .into_iter()
-            .enumerate()
-            .map(|(top, stresses)| PerState {
-                bending: None,
-                stresses,
-                stress_seconds: secs,
-                buckling: None,
-                mode: Vec::new(),
-                fe_seconds: 0.0,
-                top_layer: cap.sections.layers.get(top).map_or(0, |l| l.id),
-                green: None,
-            })
-            .collect()
-    } else {
-        (0..total)
-            .into_par_iter()
-            .map(|top| {
-                cancelled()?;
-                let t0 = Instant::now();
-                let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-                // Only the extremes are kept: all element stresses of every state would take memory
-                // quadratic in the bay length (0.7 GB for a 4 m bay).
-                let (stresses, bending) = if cap.centre_arches.is_empty() {
-                    (StressExtremes::of(&element_stresses(&state, areas)?), None)
-                } else {
-                    // The bending part of the corrugation (`crate::analysis::bending`).
+    let mut per: Vec<PerState> = (0..total)
+        .into_par_iter()
+        .map(|top| {
+            cancelled()?;
+            let t0 = Instant::now();
+            let summary = cap.states.get(top);
+            let (stresses, bending) = match summary.and_then(|s| s.stresses) {
+                Some(stresses) => (stresses, None),
+                None => {
+                    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
                     let mat = crate::analysis::buckling::state_material_with(
                         cap,
                         options,
@@ -854,20 +825,20 @@ fn assemble(
                     let (all, bending) =
                         crate::analysis::bending::corrugated_stresses(&state, areas, &mat)?;
                     (StressExtremes::of(&all), bending)
-                };
-                Ok(PerState {
-                    bending,
-                    stresses,
-                    stress_seconds: t0.elapsed().as_secs_f64(),
-                    buckling: None,
-                    mode: Vec::new(),
-                    fe_seconds: 0.0,
-                    top_layer: state.top_layer,
-                    green: None,
-                })
+                }
+            };
+            Ok(PerState {
+                bending,
+                stresses,
+                stress_seconds: t0.elapsed().as_secs_f64(),
+                buckling: None,
+                mode: Vec::new(),
+                fe_seconds: 0.0,
+                top_layer: summary.map_or(0, |s| s.top_layer),
+                green: None,
             })
-            .collect::<Result<_, DesignError>>()?
-    };
+        })
+        .collect::<Result<_, DesignError>>()?;
     let wall_stresses = t_phase.elapsed().as_secs_f64();
     for f in fe {
         if let Some(p) = per.get_mut(f.state) {

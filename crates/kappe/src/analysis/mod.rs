@@ -23,10 +23,13 @@
 //! Tolerances: a stress passes if it is within `1e-9·max|σ|` of its limit (the relative size of
 //! the force pass's residuals, method.md §9), so that σ_max = 0 is not failed by round-off.
 //!
-//! The modules follow the analysis: [`options`] (what to analyse), [`overhang`] (layer overhang,
-//! computed during form-finding), [`stress`] (element normal stresses), [`ageing`] (the
-//! green material's modulus by layer age), [`buckling`] (the shell buckling run of one state)
-//! and [`check`] ([`analyze`]: every state against every constraint, and the report).
+//! The modules follow the analysis: [`buckling`] (the shell buckling run of one state, on the
+//! mesh of [`shell`] or [`graded`]), [`convergence`] (the converged factor), [`asprinted`] (the
+//! shape as printed), [`green`] (the aged material's strength), [`bending`] (a corrugated
+//! state's bending), [`collapse`] (the nonlinear path), [`reliability`] and
+//! [`blf_sensitivity`] (FORM), and [`check`] ([`analyze`]: every state against every
+//! constraint, and the report). The element stresses and the overhangs come with the form
+//! ([`crate::form::stresses`], [`crate::form::overhang`]).
 
 pub(crate) mod asprinted;
 pub(crate) mod bending;
@@ -42,6 +45,7 @@ pub(crate) mod shell;
 pub(crate) mod stress;
 
 pub use crate::form::overhang::layer_overhangs;
+pub use crate::form::stresses::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 pub use crate::input::ageing::Ageing;
 pub use crate::input::analysis::{AnalysisOptions, SelectionError, StateSelection};
 pub use buckling::{
@@ -49,7 +53,6 @@ pub use buckling::{
     state_buckling, state_buckling_mode, state_material,
 };
 pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
-pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};

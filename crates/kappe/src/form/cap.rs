@@ -11,6 +11,7 @@ use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
 use crate::form::section::{Sections, build_corrugated_sections, build_sections_with_end};
 use crate::form::states::{State, build_state};
+use crate::form::stresses::{StressExtremes, element_stresses_of};
 use crate::input::context::Context;
 use crate::input::design::Design;
 use crate::input::error::DesignError;
@@ -34,6 +35,11 @@ pub struct StateSummary {
     /// Forces, stresses, residual and reactions.
     #[serde(flatten)]
     pub forces: StateForces,
+    /// The extremes of the element stresses of the network (σ = N/A) of a prismatic cap, from the
+    /// same force pass; `None` for a corrugated cap, whose stresses include the shell's bending
+    /// (`crate::analysis::bending`).
+    #[serde(skip)]
+    pub stresses: Option<StressExtremes>,
 }
 
 /// A designed cap: every intermediate product of the pipeline.
@@ -213,6 +219,8 @@ pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignEr
             state_forces(&state, area)?
         };
         context.step(total);
+        let stresses = (!corrugated)
+            .then(|| StressExtremes::of(&element_stresses_of(&state, &topology, &pass, area)));
         let summary = StateSummary {
             index: state.index,
             progress: state.progress,
@@ -221,6 +229,7 @@ pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignEr
             nodes: state.network.nodes.len(),
             factors: state.factors.clone(),
             forces,
+            stresses,
         };
         Ok::<_, DesignError>((state, topology, pass, summary))
     };

@@ -1,6 +1,7 @@
 //! Floor 1, **the form**: the layer arch form-found with constrained CEM ([`arch`]) in its
 //! tilted frame ([`frame`]), the centre and start sections ([`section`]) and the ends
-//! ([`ends`]), the network of every print state ([`states`]) and its forces ([`forces`]), the
+//! ([`ends`]), the network of every print state ([`states`]), its forces ([`forces`]) and element stresses
+//! ([`stresses`]), the
 //! layers' overhang ([`overhang`]), the print path ([`path`]) and the printed beads
 //! ([`beads`]); [`cap`] ties them into a [`Cap`]. Imports only [`crate::input`].
 
@@ -14,6 +15,7 @@ pub(crate) mod overhang;
 pub(crate) mod path;
 pub(crate) mod section;
 pub(crate) mod states;
+pub(crate) mod stresses;
 
 pub use cap::{Cap, StateSummary, design_cap};
 
@@ -25,3 +27,4 @@ pub use frame::{LayerFrame, V3};
 pub use overhang::{layer_overhangs, measured_overhangs};
 pub use section::{NodeKind, Sections, build_sections_with_end};
 pub use states::{Role, build_state};
+pub use stresses::{ElementKind, ElementStress, STRESS_REL_TOL, StressExtremes, element_stresses};
