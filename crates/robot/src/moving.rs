@@ -65,11 +65,13 @@ use crate::base_trajectory::{BaseSample, BaseTrajectory};
 use crate::collision::Scene;
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, angle_between};
-use crate::kinematics::{Joints, UR10E, joint_delta, within_limits};
-use crate::ladder::{LadderFailure, solve_optimal, solve_random};
+use crate::kinematics::{Joints, UR10E, within_limits};
+use crate::ladder::LadderFailure;
 use crate::plan::{CLEARANCE_CUTOFF, LayerPlan, Plan, Station, Waypoint, plan_layers};
-use crate::planner::{Context, Rejections, Vertex, summarise, validate};
-use crate::setup::{PlanOptions, PlannerKind, PrintLayer, RobotSetup};
+use crate::planner::{
+    Context, Rejections, Vertex, WindUp, solve_rungs, summarise, unwrap_path, validate,
+};
+use crate::setup::{PlanOptions, PrintLayer, RobotSetup};
 use crate::timing::LayerWait;
 
 /// How the base takes part in the print: stations (print, stop, drive, re-localise) or moving
@@ -724,41 +726,8 @@ fn plan_with_lead(
         .par_iter()
         .map(|&(o, k)| geo.vertices(&base.pose_at(sign * (lead + offsets[o][k])), o, k))
         .collect();
-    let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
-    let vmax = ctx.opts.limits.max_speed();
-    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
-        .map(|r| {
-            let (o0, k0) = rung_ids[r];
-            let (o1, k1) = rung_ids[r + 1];
-            let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
-            let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
-            let dt = (p1 - p0).length() / ctx.opts.print_speed;
-            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
-        })
-        .collect();
-    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
-    let step_cost = |a: &Joints, b: &Joints| -> f64 {
-        let d = joint_delta(a, b);
-        d[..n_cost].iter().map(|v| v * v).sum()
-    };
-    let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
-        let a = &built[r].0[i].q;
-        let b = &built[r + 1].0[j].q;
-        if branch(a) != branch(b) {
-            return None;
-        }
-        let d = joint_delta(a, b);
-        if (0..n_cost).any(|jj| d[jj].abs() > steps[r][jj]) {
-            return None;
-        }
-        let c = step_cost(a, b);
-        (c <= ctx.opts.epsilon).then_some(c)
-    };
-    let result = match ctx.opts.planner {
-        PlannerKind::Optimal => solve_optimal(&sizes, edge),
-        PlannerKind::Random => solve_random(&sizes, edge, ctx.opts.random_trials, ctx.opts.seed),
-    };
+    let result = solve_rungs(ctx, &rung_ids, &built, ctx.opts.seed);
     let path = match result {
         Ok(p) => p,
         Err(LadderFailure::EmptyRung { rung }) => {
@@ -787,42 +756,10 @@ fn plan_with_lead(
             ));
         }
     };
-    let canon: Vec<Joints> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].q)
-        .collect();
-    let clear: Vec<f64> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].clearance)
-        .collect();
     // Unwrap (elbow raw) and one 2π offset per joint, as the station planner.
-    let mut q = canon.clone();
-    for r in 1..canon.len() {
-        let d = joint_delta(&canon[r - 1], &canon[r]);
-        for j in 0..6 {
-            q[r][j] = q[r - 1][j] + d[j];
-        }
-    }
-    let tau = std::f64::consts::TAU;
-    for j in 0..6 {
-        let lo = q.iter().map(|v| v[j]).fold(f64::INFINITY, f64::min);
-        let hi = q.iter().map(|v| v[j]).fold(f64::NEG_INFINITY, f64::max);
-        let mid = 0.5 * (lo + hi);
-        let mut best: Option<f64> = None;
-        for m in -3i32..=3 {
-            let s = f64::from(m) * tau;
-            if lo + s >= ctx.limits[j][0] - 1e-12
-                && hi + s <= ctx.limits[j][1] + 1e-12
-                && best.is_none_or(|b| (mid + s).abs() < (mid + b).abs())
-            {
-                best = Some(s);
-            }
-        }
-        let Some(s) = best else {
+    let (q, clear) = match unwrap_path(ctx, &built, &path) {
+        Ok(p) => p,
+        Err(WindUp { joint: j, lo, hi }) => {
             return Err(fail(
                 0,
                 0,
@@ -832,11 +769,8 @@ fn plan_with_lead(
                     j + 1
                 ),
             ));
-        };
-        for v in &mut q {
-            v[j] += s;
         }
-    }
+    };
     let mut layers_out = Vec::with_capacity(ctx.layers.len());
     let mut travel = Vec::with_capacity(ctx.layers.len());
     let mut r = 0;

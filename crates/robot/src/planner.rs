@@ -16,7 +16,7 @@ use crate::collision::{CapsuleSpec, LINK_NAMES, Obstacle, RobotModel, Scene, TOO
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, frame_from_z};
 use crate::kinematics::{Joints, UR10E, joint_delta, representable_in_limits};
-use crate::ladder::{LadderFailure, solve_optimal, solve_random};
+use crate::ladder::{LadderFailure, LadderPath, solve_optimal, solve_random};
 use crate::plan::{CLEARANCE_CUTOFF, LayerPlan, Plan, PlanMark, Station, Waypoint};
 use crate::setup::{BasePlacement, PlanOptions, PlannerKind, PrintLayer, RobotSetup};
 
@@ -73,6 +73,16 @@ pub(crate) fn validate(
             ))
         }
     };
+    let non_negative = |name: &str, v: f64| {
+        if v.is_finite() && v >= 0.0 {
+            Ok(())
+        } else {
+            Err(RobotError::invalid(
+                name,
+                format!("{v}: must be finite and ≥ 0"),
+            ))
+        }
+    };
     pos("epsilon (rad²)", opts.epsilon)?;
     pos("print_speed (m/s)", opts.print_speed)?;
     pos("transition_speed_fraction", opts.transition_speed_fraction)?;
@@ -93,12 +103,7 @@ pub(crate) fn validate(
         ("station_change_time (s)", opts.station_change_time),
         ("reconfiguration_penalty", opts.reconfiguration_penalty),
     ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(RobotError::invalid(
-                name,
-                format!("{v}: must be finite and ≥ 0"),
-            ));
-        }
+        non_negative(name, v)?;
     }
     if !opts.bead_offset.is_finite()
         || !opts.q6.is_finite()
@@ -132,12 +137,7 @@ pub(crate) fn validate(
         ("program.program_switch_time (s)", pr.program_switch_time),
         ("program.payload_mass (kg)", pr.payload_mass),
     ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(RobotError::invalid(
-                name,
-                format!("{v}: must be finite and ≥ 0"),
-            ));
-        }
+        non_negative(name, v)?;
     }
     if !pr.payload_cog.iter().all(|v| v.is_finite()) {
         return Err(RobotError::invalid(
@@ -316,6 +316,13 @@ impl Rejections {
 }
 
 impl Context {
+    /// The ladder's edge cost Σ Δq² (Δq wrapped; q6 left out for a coaxial tool, module docs).
+    pub(crate) fn step_cost(&self, a: &Joints, b: &Joints) -> f64 {
+        let n_cost = if self.coaxial { 5 } else { 6 };
+        let d = joint_delta(a, b);
+        d[..n_cost].iter().map(|v| v * v).sum()
+    }
+
     /// TCP frame of a target (φ = 0), world: z = tool axis, x from the path tangent.
     pub fn target_frame(&self, layer: &PrintLayer, k: usize) -> Iso {
         let pts = &layer.points;
@@ -613,49 +620,13 @@ pub(crate) fn plan_station_cached(
         Some((_, b)) => &b[..rung_ids.len()],
         None => &[],
     };
-    let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
-    // Allowed joint step per rung boundary. The layer change is a printed move like any other
-    // (continuous extrusion), so the same speed, ε and branch rules hold across it.
-    let vmax = ctx.opts.limits.max_speed();
-    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
-        .map(|r| {
-            let (o0, k0) = rung_ids[r];
-            let (o1, k1) = rung_ids[r + 1];
-            let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
-            let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
-            let dt = (p1 - p0).length() / ctx.opts.print_speed;
-            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
-        })
-        .collect();
-    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
-    let step_cost = |a: &Joints, b: &Joints| -> f64 {
-        let d = joint_delta(a, b);
-        d[..n_cost].iter().map(|v| v * v).sum()
-    };
-    let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
-        let a = &built[r].0[i].q;
-        let b = &built[r + 1].0[j].q;
-        let lim = &steps[r];
-        if branch(a) != branch(b) {
-            return None;
-        }
-        let d = joint_delta(a, b);
-        if (0..n_cost).any(|j| d[j].abs() > lim[j]) {
-            return None;
-        }
-        let c = step_cost(a, b);
-        (c <= ctx.opts.epsilon).then_some(c)
-    };
-    let result = match ctx.opts.planner {
-        PlannerKind::Optimal => solve_optimal(&sizes, edge),
-        PlannerKind::Random => solve_random(
-            &sizes,
-            edge,
-            ctx.opts.random_trials,
-            ctx.opts.seed.wrapping_add(station as u64),
-        ),
-    };
+    let result = solve_rungs(
+        ctx,
+        &rung_ids,
+        built,
+        ctx.opts.seed.wrapping_add(station as u64),
+    );
     let path = match result {
         Ok(p) => p,
         Err(LadderFailure::EmptyRung { rung }) => {
@@ -673,7 +644,7 @@ pub(crate) fn plan_station_cached(
             let mut best = f64::INFINITY;
             for a in &built[rung - 1].0 {
                 for b in &built[rung].0 {
-                    best = best.min(step_cost(&a.q, &b.q));
+                    best = best.min(ctx.step_cost(&a.q, &b.q));
                 }
             }
             let detail = format!(
@@ -692,45 +663,9 @@ pub(crate) fn plan_station_cached(
             ));
         }
     };
-    // Canonical path, then unwrap (elbow raw) and choose one 2π offset per joint.
-    let canon: Vec<Joints> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].q)
-        .collect();
-    let clear: Vec<f64> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].clearance)
-        .collect();
-    let mut unwrapped = canon.clone();
-    for r in 1..canon.len() {
-        let d = joint_delta(&canon[r - 1], &canon[r]);
-        for j in 0..6 {
-            unwrapped[r][j] = unwrapped[r - 1][j] + d[j];
-        }
-    }
-    for j in 0..6 {
-        let lo = unwrapped.iter().map(|q| q[j]).fold(f64::INFINITY, f64::min);
-        let hi = unwrapped
-            .iter()
-            .map(|q| q[j])
-            .fold(f64::NEG_INFINITY, f64::max);
-        let mid = 0.5 * (lo + hi);
-        let tau = std::f64::consts::TAU;
-        let mut best: Option<f64> = None;
-        for m in -3i32..=3 {
-            let s = f64::from(m) * tau;
-            if lo + s >= ctx.limits[j][0] - 1e-12 && hi + s <= ctx.limits[j][1] + 1e-12 {
-                let better = best.is_none_or(|b| (mid + s).abs() < (mid + b).abs());
-                if better {
-                    best = Some(s);
-                }
-            }
-        }
-        let Some(s) = best else {
+    let (unwrapped, clear) = match unwrap_path(ctx, built, &path) {
+        Ok(p) => p,
+        Err(WindUp { joint: j, lo, hi }) => {
             let l = &ctx.layers[range.start];
             return Err(fail(
                 l.layer,
@@ -742,11 +677,8 @@ pub(crate) fn plan_station_cached(
                     ctx.limits[j]
                 ),
             ));
-        };
-        for q in &mut unwrapped {
-            q[j] += s;
         }
-    }
+    };
     // Layer summaries and collision checks of the joint-interpolated layer changes; the times
     // come later from [`crate::timing`], once the whole plan is known.
     let mut layers_out = Vec::new();
@@ -799,6 +731,114 @@ pub(crate) fn plan_station_cached(
         world_from_base: world_from_base.to_mat4(),
         layers: layers_out,
     })
+}
+
+/// The ladder search over the rungs `built`: the valid vertices of the targets `rung_ids`
+/// ((layer order, point), in print order). An edge keeps the elbow and wrist branches, moves
+/// each joint at most its speed limit (`speed_fraction · v_max`) over the move's time at the
+/// print speed, and costs Σ Δq² ≤ ε (module docs). The layer change is a printed move like any
+/// other (continuous extrusion), so the same rules hold across it. `seed` drives the random
+/// planner. Stations and the moving base search the same way.
+pub(crate) fn solve_rungs(
+    ctx: &Context,
+    rung_ids: &[(usize, usize)],
+    built: &[(Vec<Vertex>, Rejections)],
+    seed: u64,
+) -> Result<LadderPath, LadderFailure> {
+    let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
+    let n_cost = if ctx.coaxial { 5 } else { 6 };
+    let vmax = ctx.opts.limits.max_speed();
+    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
+        .map(|r| {
+            let (o0, k0) = rung_ids[r];
+            let (o1, k1) = rung_ids[r + 1];
+            let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
+            let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
+            let dt = (p1 - p0).length() / ctx.opts.print_speed;
+            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
+        })
+        .collect();
+    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
+    let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
+        let a = &built[r].0[i].q;
+        let b = &built[r + 1].0[j].q;
+        let lim = &steps[r];
+        if branch(a) != branch(b) {
+            return None;
+        }
+        let d = joint_delta(a, b);
+        if (0..n_cost).any(|j| d[j].abs() > lim[j]) {
+            return None;
+        }
+        let c = ctx.step_cost(a, b);
+        (c <= ctx.opts.epsilon).then_some(c)
+    };
+    match ctx.opts.planner {
+        PlannerKind::Optimal => solve_optimal(&sizes, edge),
+        PlannerKind::Random => solve_random(&sizes, edge, ctx.opts.random_trials, seed),
+    }
+}
+
+/// No multiple of 2π fits joint `joint`'s travel `lo..hi` (rad) into its range.
+pub(crate) struct WindUp {
+    pub joint: usize,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// The joints and clearances along a ladder path: the canonical vertices unwrapped (each step
+/// the wrapped Δq; the elbow raw) and every joint shifted by the multiple of 2π that keeps its
+/// whole travel inside the limits with its middle nearest zero.
+pub(crate) fn unwrap_path(
+    ctx: &Context,
+    built: &[(Vec<Vertex>, Rejections)],
+    path: &LadderPath,
+) -> Result<(Vec<Joints>, Vec<f64>), WindUp> {
+    let canon: Vec<Joints> = path
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(r, &v)| built[r].0[v].q)
+        .collect();
+    let clear: Vec<f64> = path
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(r, &v)| built[r].0[v].clearance)
+        .collect();
+    let mut unwrapped = canon.clone();
+    for r in 1..canon.len() {
+        let d = joint_delta(&canon[r - 1], &canon[r]);
+        for j in 0..6 {
+            unwrapped[r][j] = unwrapped[r - 1][j] + d[j];
+        }
+    }
+    let tau = std::f64::consts::TAU;
+    for j in 0..6 {
+        let lo = unwrapped.iter().map(|q| q[j]).fold(f64::INFINITY, f64::min);
+        let hi = unwrapped
+            .iter()
+            .map(|q| q[j])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let mid = 0.5 * (lo + hi);
+        let mut best: Option<f64> = None;
+        for m in -3i32..=3 {
+            let s = f64::from(m) * tau;
+            if lo + s >= ctx.limits[j][0] - 1e-12
+                && hi + s <= ctx.limits[j][1] + 1e-12
+                && best.is_none_or(|b| (mid + s).abs() < (mid + b).abs())
+            {
+                best = Some(s);
+            }
+        }
+        let Some(s) = best else {
+            return Err(WindUp { joint: j, lo, hi });
+        };
+        for q in &mut unwrapped {
+            q[j] += s;
+        }
+    }
+    Ok((unwrapped, clear))
 }
 
 /// Check the joint-interpolated move a → b at ≤ 1° steps; `order` is the layer about to start
