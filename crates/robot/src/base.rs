@@ -7,8 +7,10 @@ use rayon::prelude::*;
 
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::Iso;
-use crate::plan::{Context, RungCache, Station, plan_station_cached};
+use crate::plan::Station;
+use crate::planner::{Context, RungCache, plan_station_cached};
 use crate::setup::BaseSearch;
+use crate::setup::{BaseTolerance, sampled_errors};
 
 /// Candidate base poses of the grid, nearest the grid centre first (deterministic order).
 fn candidates(ctx: &Context, s: &BaseSearch) -> Result<Vec<Iso>, RobotError> {
@@ -91,10 +93,10 @@ fn robust_cover(
     cands: &[Iso],
     mut cover: Vec<usize>,
     order: &mut Vec<usize>,
-    tol: &crate::tolerance::BaseTolerance,
+    tol: &BaseTolerance,
     start: usize,
 ) -> Vec<usize> {
-    let errors = crate::tolerance::sampled_errors(tol);
+    let errors = sampled_errors(tol);
     let top: Vec<usize> = order.iter().copied().take(MARGIN_CANDIDATES).collect();
     let robust: Vec<usize> = top
         .par_iter()

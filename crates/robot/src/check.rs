@@ -9,16 +9,28 @@ use serde::Serialize;
 
 use crate::frames::{Iso, angle_between};
 use crate::kinematics::{Joints, UR10E, within_limits};
-use crate::plan::Station;
-use crate::plan::{CLEARANCE_CUTOFF, Plan, transition_collision, validate};
+use crate::plan::{CLEARANCE_CUTOFF, CertifiedClearance, Plan, Station, plan_layers};
+use crate::planner::{transition_collision, validate};
 use crate::setup::PlanOptions;
-use crate::setup::{PathPoint, PrintLayer};
 
 /// Smallest certified clearance of the approach and retract moves (m): clear of contact.
 const CONTACT: f64 = 1e-9;
 
 /// Tolerance of the TCP position (m) and tool axis (rad) on the targets (acceptance: 1e-6).
 pub const TARGET_TOL: f64 = 1e-6;
+
+// The certified values sit in the plan (`Plan::certified`), which stands below the check.
+impl CertifiedClearance {
+    /// The certified values of a check report.
+    pub fn of(rep: &CheckReport) -> Self {
+        CertifiedClearance {
+            clearance: rep.certified_clearance,
+            approach_clearance: rep.certified_approach_clearance,
+            self_distance: rep.certified_self_distance,
+            configurations: rep.certified_configurations,
+        }
+    }
+}
 
 /// Result of [`check_plan`]; the plan is valid when `problems` is empty.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -60,7 +72,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         ..Default::default()
     };
     let mut problems = Vec::new();
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
@@ -135,7 +147,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 .map(|w| (w.q, order + st.layers.len(), "retract")),
         ];
         for (q, tag, what) in ends.into_iter().flatten() {
-            match crate::program::approach_config(
+            match crate::kinematics::approach_config(
                 &q,
                 &flange_from_tcp,
                 opts.program.approach_distance,
@@ -166,7 +178,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         // retract need only be clear of contact.
         let mut motions: Vec<(Vec<Joints>, usize, [f64; 2], String)> = Vec::new();
         for (what, q, tag) in ends.iter().flatten().map(|(q, tag, what)| (what, q, tag)) {
-            if let Ok(qa) = crate::program::approach_config(
+            if let Ok(qa) = crate::kinematics::approach_config(
                 q,
                 &flange_from_tcp,
                 opts.program.approach_distance,
@@ -396,25 +408,4 @@ fn check_rates(
         }
     }
     (rv, ra)
-}
-
-/// The print targets of a plan as the planner's input layers (every station's layers in print
-/// order), so a check can validate them with the planner's own rules.
-pub(crate) fn plan_layers(plan: &Plan) -> Vec<PrintLayer> {
-    plan.stations
-        .iter()
-        .flat_map(|s| &s.layers)
-        .map(|l| PrintLayer {
-            layer: l.layer,
-            points: l
-                .waypoints
-                .iter()
-                .map(|w| PathPoint {
-                    index: w.index,
-                    position: w.position,
-                    axis: w.axis,
-                })
-                .collect(),
-        })
-        .collect()
 }

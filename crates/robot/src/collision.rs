@@ -360,7 +360,7 @@ struct SceneShape {
 }
 
 /// Capsule chain segments, chunked with bounding boxes, tagged by layer. Chunks are grouped
-/// (consecutive chunks, [`GROUP`] at a time) under a second level of boxes with the group's
+/// (consecutive chunks, `GROUP` at a time) under a second level of boxes with the group's
 /// smallest layer tag, so that a query skips whole groups that are far or not yet printed: a
 /// two-level bounding-volume hierarchy. Both levels are lower bounds, so the result is exact.
 #[derive(Clone, Debug, Default)]

@@ -39,6 +39,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::RobotError;
 use crate::frames::Iso;
 use crate::kinematics::UR10E;
+pub use crate::lint::{lint_tracking, tracking_form_problems, uses_tracking};
 use crate::moving::MovingPlan;
 use crate::program::{ProgramFile, flow_output};
 use crate::setup::{AnalogDomain, DigitalOutput, PauseMode};
@@ -296,7 +297,7 @@ pub fn tracking_program_files(
             if let Some(s) = enable(false) {
                 line(&s, &mut depth);
             }
-            let qa = crate::program::approach_config(
+            let qa = crate::kinematics::approach_config(
                 &first_wp.q,
                 &tool,
                 pr.approach_distance,
@@ -580,100 +581,4 @@ pub fn tracking_index_json(files: &[(ProgramFile, TrackingStart)]) -> String {
         &serde_json::json!({ "programs": list, "mode": "moving base, conveyor tracking" }),
     )
     .unwrap_or_else(|_| "{}".into())
-}
-
-/// `name(` called on line `l` (not part of a longer identifier), outside comments.
-fn calls(l: &str, name: &str) -> bool {
-    let code = l.split('#').next().unwrap_or("");
-    code.match_indices(name).any(|(i, _)| {
-        let before = code[..i].chars().last();
-        let after = code[i + name.len()..].trim_start().chars().next();
-        !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_') && after == Some('(')
-    })
-}
-
-const TRACKING_CALLS: &[&str] = &[
-    "conveyor_pulse_decode",
-    "encoder_enable_pulse_decode",
-    "track_conveyor_linear",
-    "stop_conveyor_tracking",
-    "end_conveyor_tracking",
-];
-
-/// Whether a program uses conveyor tracking at all (then [`crate::lint_with_limits`] applies
-/// [`tracking_form_problems`]).
-pub fn uses_tracking(text: &str) -> bool {
-    text.lines()
-        .any(|l| TRACKING_CALLS.iter().any(|n| calls(l, n)))
-}
-
-/// The tracking form of a program (see [`lint_tracking`]), as problems.
-pub fn tracking_form_problems(text: &str) -> Vec<String> {
-    let mut problems = Vec::new();
-    let mut decoder = false;
-    let mut tracking: Option<usize> = None;
-    let mut tracked_moves = 0usize;
-    for (i, l) in text.lines().enumerate() {
-        let ln = i + 1;
-        if calls(l, "conveyor_pulse_decode") || calls(l, "encoder_enable_pulse_decode") {
-            decoder = true;
-        }
-        if calls(l, "track_conveyor_linear") {
-            if !decoder {
-                problems.push(format!(
-                    "line {ln}: track_conveyor_linear() before the encoder is set up (conveyor_pulse_decode)"
-                ));
-            }
-            if let Some(s) = tracking {
-                problems.push(format!(
-                    "line {ln}: track_conveyor_linear() while already tracking (since line {s})"
-                ));
-            }
-            tracking = Some(ln);
-        }
-        if tracking.is_some() && (calls(l, "movej") || calls(l, "servoj")) {
-            problems.push(format!(
-                "line {ln}: a joint target while tracking the base (joint targets hold only at the base pose they were planned for)"
-            ));
-        }
-        if tracking.is_some() && (calls(l, "movep") || calls(l, "movel") || calls(l, "movec")) {
-            tracked_moves += 1;
-        }
-        if calls(l, "stop_conveyor_tracking") || calls(l, "end_conveyor_tracking") {
-            if tracking.is_none() {
-                problems.push(format!("line {ln}: tracking stopped but never started"));
-            }
-            tracking = None;
-        }
-    }
-    if let Some(s) = tracking {
-        problems.push(format!(
-            "tracking started on line {s} is never stopped (stop_conveyor_tracking) before the program ends"
-        ));
-    }
-    if tracked_moves == 0 {
-        problems.push(
-            "no motion target while tracking the base: not a conveyor-tracking program".into(),
-        );
-    }
-    problems
-}
-
-/// Lint a conveyor-tracking program: [`crate::lint_with_limits`] (which knows the conveyor
-/// functions' signatures and ranges, and applies the tracking form below to any program that
-/// uses tracking) plus: the program must track. The tracking form:
-///
-/// - `track_conveyor_linear` only after a decoder is set up (`conveyor_pulse_decode` or
-///   `encoder_enable_pulse_decode`) and never while already tracking;
-/// - no joint target (`movej`, `servoj`) while tracking: a joint target is valid only at the
-///   base pose it was planned for;
-/// - tracking stopped (`stop_conveyor_tracking` / `end_conveyor_tracking`) before the program
-///   ends, and never stopped when not tracking;
-/// - at least one tracked motion target.
-pub fn lint_tracking(text: &str, max_targets: usize, limits: &[[f64; 2]; 6]) -> crate::LintReport {
-    let mut rep = crate::lint_with_limits(text, max_targets, limits);
-    if !uses_tracking(text) {
-        rep.problems.extend(tracking_form_problems(text));
-    }
-    rep
 }

@@ -13,6 +13,7 @@ use std::f64::consts::{PI, TAU};
 use parry3d_f64::glamx::{DMat3, DVec3};
 use serde::{Deserialize, Serialize};
 
+use crate::error::RobotError;
 use crate::frames::Iso;
 
 /// Six joint values (rad), joints 1 (base) … 6 (wrist 3).
@@ -320,4 +321,39 @@ pub fn within_limits(q: &Joints, limits: &[[f64; 2]; 6]) -> bool {
     q.iter()
         .zip(limits)
         .all(|(v, l)| *v >= l[0] - 1e-12 && *v <= l[1] + 1e-12)
+}
+
+/// The safe approach configuration: the first target backed off `dist` along the tool axis,
+/// the IK solution nearest `q` (same branch), unwrapped next to `q`.
+pub(crate) fn approach_config(
+    q: &Joints,
+    tool: &Iso,
+    dist: f64,
+    limits: &[[f64; 2]; 6],
+) -> Result<Joints, RobotError> {
+    let tcp = UR10E.fk(q).mul(tool);
+    let back = tcp.mul(&Iso::translation(0.0, 0.0, -dist));
+    let flange = back.mul(&tool.inverse());
+    let sols = UR10E.ik(&flange);
+    let mut best: Option<(f64, Joints)> = None;
+    for s in sols.as_slice() {
+        let d = joint_delta(q, s);
+        let cand: Joints = std::array::from_fn(|j| q[j] + d[j]);
+        if !within_limits(&cand, limits) {
+            continue;
+        }
+        let c: f64 = d.iter().map(|v| v * v).sum();
+        if best.is_none_or(|b| c < b.0) {
+            best = Some((c, cand));
+        }
+    }
+    best.map(|b| b.1).ok_or_else(|| {
+        RobotError::invalid(
+            "program.approach_distance",
+            format!(
+                "no joint configuration reaches the approach pose {dist} m behind the target {:?}",
+                tcp.t.to_array()
+            ),
+        )
+    })
 }

@@ -14,13 +14,14 @@ use parry3d_f64::math::Pose;
 use parry3d_f64::query;
 use parry3d_f64::shape::{Capsule, ConvexPolyhedron};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
 use crate::collision::{LINK_NAMES, TOOL_LINK};
 use crate::error::RobotError;
 use crate::frames::Iso;
 use crate::kinematics::Joints;
-use crate::plan::{Plan, validate};
+pub use crate::plan::{AlongMotion, ClearanceAt, MESH_CUTOFF, MeshReport, ModelClearance};
+use crate::plan::{Plan, plan_layers};
+use crate::planner::validate;
 
 const STL: [&[u8]; 7] = [
     include_bytes!("../assets/ur10e/base.stl"),
@@ -53,9 +54,6 @@ const JOINTS: [([f64; 3], [f64; 3]); 6] = [
         ],
     ),
 ];
-
-/// Environment clearances of the meshes above this (m) are reported as this value.
-pub const MESH_CUTOFF: f64 = 0.1;
 
 const HALF_PI: f64 = std::f64::consts::FRAC_PI_2;
 const PI: f64 = std::f64::consts::PI;
@@ -177,67 +175,14 @@ impl ArmMeshes {
     }
 }
 
-/// Where a model's smallest clearance or self distance occurs.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ClearanceAt {
-    /// Metres (0 = touching or overlapping for the meshes; negative = overlap depth for capsules).
-    pub distance: f64,
-    pub station: usize,
-    pub layer: i64,
-    pub index: usize,
-    /// Link or link pair, and the object.
-    pub what: String,
-}
-
-/// Clearance of one geometric model over the checked waypoints.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ModelClearance {
-    /// Smallest distance of the arm (links 1–6) to the environment (beams, mobile base, floor,
-    /// printed layers), capped at [`MESH_CUTOFF`].
-    pub environment: ClearanceAt,
-    /// Smallest distance of the 13 self-collision pairs.
-    pub self_distance: ClearanceAt,
-}
-
-/// The plan measured with the capsules and with UR's collision meshes.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MeshReport {
-    pub waypoints_checked: usize,
-    pub mesh_vertices: Vec<usize>,
-    pub capsules: ModelClearance,
-    pub meshes: ModelClearance,
-    /// The nozzle (a capsule in both models, clipped near the tip) to the environment.
-    pub nozzle: ClearanceAt,
-    /// Certified smallest clearances of the meshes between the waypoints (joint-interpolated
-    /// print moves and layer changes; [`crate::sweep`]), when measured.
-    #[serde(default)]
-    pub along_motion: Option<AlongMotion>,
-    /// Mesh contacts (distance 0 to the environment or on a self pair).
-    pub problems: Vec<String>,
-}
-
-/// Certified lower bounds of the mesh model's clearances along the whole motion (the layer
-/// where each occurs; `index` and `what` are not resolved for a bound).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct AlongMotion {
-    /// Arm meshes (links 1–6) to the environment, capped at [`MESH_CUTOFF`].
-    pub environment: ClearanceAt,
-    /// The nozzle capsules to the environment.
-    pub nozzle: ClearanceAt,
-    /// The 13 self pairs on the meshes.
-    pub self_distance: ClearanceAt,
-    /// Configurations measured (waypoints and midpoints added by the splits).
-    pub configurations: usize,
-}
-
 #[derive(Clone, Debug)]
-struct One {
-    at: (usize, i64, usize),
-    cap_env: (f64, String),
-    cap_self: (f64, String),
-    nozzle: (f64, String),
-    mesh_env: (f64, String),
-    mesh_self: (f64, String),
+pub(crate) struct One {
+    pub(crate) at: (usize, i64, usize),
+    pub(crate) cap_env: (f64, String),
+    pub(crate) cap_self: (f64, String),
+    pub(crate) nozzle: (f64, String),
+    pub(crate) mesh_env: (f64, String),
+    pub(crate) mesh_self: (f64, String),
 }
 
 fn better(a: &mut ClearanceAt, d: f64, at: (usize, i64, usize), what: &str, first: bool) {
@@ -257,17 +202,17 @@ fn better(a: &mut ClearanceAt, d: f64, at: (usize, i64, usize), what: &str, firs
 type LayerPath = (usize, i64, Vec<Joints>, Option<std::ops::Range<usize>>);
 
 /// What one configuration is measured against.
-struct Probe<'a> {
-    ctx: &'a crate::plan::Context,
-    meshes: &'a ArmMeshes,
-    scene: &'a crate::collision::Scene,
-    world_from_base: Iso,
-    tool_caps: &'a [crate::collision::CapsuleSpec],
+pub(crate) struct Probe<'a> {
+    pub(crate) ctx: &'a crate::planner::Context,
+    pub(crate) meshes: &'a ArmMeshes,
+    pub(crate) scene: &'a crate::collision::Scene,
+    pub(crate) world_from_base: Iso,
+    pub(crate) tool_caps: &'a [crate::collision::CapsuleSpec],
 }
 
 impl Probe<'_> {
     /// Both models at `q`, with the layers printed before print order `o` as obstacles.
-    fn measure(&self, q: &Joints, o: usize) -> One {
+    pub(crate) fn measure(&self, q: &Joints, o: usize) -> One {
         let (ctx, meshes, scene, tool_caps) = (self.ctx, self.meshes, self.scene, self.tool_caps);
         let world_from_base = self.world_from_base;
         let q = *q;
@@ -390,7 +335,7 @@ impl Probe<'_> {
 pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotError> {
     let stride = stride.max(1);
     let meshes = ArmMeshes::load()?;
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let ctx = validate(&layers, &plan.setup, &plan.options)?;
     let tool_caps: Vec<_> = ctx
         .self_model
@@ -547,7 +492,7 @@ pub fn verify_meshes(plan: &Plan, stride: usize) -> Result<MeshReport, RobotErro
 
 /// The report of measured configurations `out`: the least clearance of each model and where,
 /// and a problem per contact (at most 20).
-fn report_of(out: &[One], meshes: &ArmMeshes, along: Option<AlongMotion>) -> MeshReport {
+pub(crate) fn report_of(out: &[One], meshes: &ArmMeshes, along: Option<AlongMotion>) -> MeshReport {
     let mut rep = MeshReport {
         waypoints_checked: out.len(),
         mesh_vertices: meshes.vertices.clone(),
@@ -605,82 +550,6 @@ fn report_of(out: &[One], meshes: &ArmMeshes, along: Option<AlongMotion>) -> Mes
         }
     }
     rep
-}
-
-/// [`verify_meshes`] for a base that moves while printing (issue 27): every `stride`-th
-/// waypoint of each layer (and its first and last), the arm posed from the base's pose at that
-/// waypoint ([`crate::moving::MovingPlan::base_pose`]). The environment (beams, floor, printed
-/// layers) stands in the world; the mobile base's own body moves with the arm, so the arm's
-/// distance to it is measured in the base frame, independent of the travel. At the waypoints
-/// only: the clearance along the motion with the base moving is certified on the capsules by
-/// [`crate::moving::check_moving`].
-///
-/// # Errors
-/// An invalid plan (shape, setup, targets) or mesh asset.
-pub fn verify_meshes_moving(
-    mp: &crate::moving::MovingPlan,
-    stride: usize,
-) -> Result<MeshReport, RobotError> {
-    mp.validate_shape()?;
-    let stride = stride.max(1);
-    let plan = &mp.plan;
-    let meshes = ArmMeshes::load()?;
-    let layers = crate::check::plan_layers(plan);
-    // The moving check's own split: the world without the body, the body in the base frame.
-    let crate::moving::Geometry {
-        world: ctx,
-        scene: world,
-        body,
-    } = crate::moving::Geometry::new(&validate(&layers, &plan.setup, &plan.options)?)?;
-    let tool_caps: Vec<_> = ctx
-        .self_model
-        .capsules
-        .iter()
-        .filter(|c| c.link == TOOL_LINK)
-        .cloned()
-        .collect();
-    let mut jobs: Vec<(usize, usize, i64, usize, Joints)> = Vec::new();
-    for (o, l) in plan.stations[0].layers.iter().enumerate() {
-        let n = l.waypoints.len();
-        for (k, w) in l.waypoints.iter().enumerate() {
-            if k % stride == 0 || k + 1 == n {
-                jobs.push((o, k, l.layer, w.index, w.q));
-            }
-        }
-    }
-    let out: Vec<One> = jobs
-        .par_iter()
-        .map(|&(o, k, layer, index, q)| {
-            let probe = Probe {
-                ctx: &ctx,
-                meshes: &meshes,
-                scene: &world,
-                world_from_base: mp.base_pose(o, k),
-                tool_caps: &tool_caps,
-            };
-            let mut one = probe.measure(&q, o);
-            if let Some(body) = &body {
-                let on_base = Probe {
-                    scene: body,
-                    world_from_base: Iso::IDENTITY,
-                    ..probe
-                };
-                let b = on_base.measure(&q, o);
-                for (mine, theirs) in [
-                    (&mut one.cap_env, b.cap_env),
-                    (&mut one.nozzle, b.nozzle),
-                    (&mut one.mesh_env, b.mesh_env),
-                ] {
-                    if theirs.0 < mine.0 {
-                        *mine = theirs;
-                    }
-                }
-            }
-            one.at = (0, layer, index);
-            one
-        })
-        .collect();
-    Ok(report_of(&out, &meshes, None))
 }
 
 /// Run [`verify_meshes`] and keep the report in the plan (`Plan::meshes`); a mesh contact is an

@@ -65,12 +65,13 @@ use crate::base_trajectory::{BaseSample, BaseTrajectory};
 use crate::collision::Scene;
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, angle_between};
-use crate::kinematics::{Joints, UR10E, joint_delta, within_limits};
-use crate::ladder::{LadderFailure, solve_optimal, solve_random};
-use crate::plan::{
-    CLEARANCE_CUTOFF, Context, LayerPlan, Plan, Station, Vertex, Waypoint, summarise, validate,
+use crate::kinematics::{Joints, UR10E, within_limits};
+use crate::ladder::LadderFailure;
+use crate::plan::{CLEARANCE_CUTOFF, LayerPlan, Plan, Station, Waypoint, plan_layers};
+use crate::planner::{
+    Context, Rejections, Vertex, WindUp, solve_rungs, summarise, unwrap_path, validate,
 };
-use crate::setup::{PlanOptions, PlannerKind, PrintLayer, RobotSetup};
+use crate::setup::{PlanOptions, PrintLayer, RobotSetup};
 use crate::timing::LayerWait;
 
 /// How the base takes part in the print: stations (print, stop, drive, re-localise) or moving
@@ -470,7 +471,7 @@ impl Geometry {
     }
 
     /// Valid vertices of target (o, k) from base pose `w`.
-    fn vertices(&self, w: &Iso, o: usize, k: usize) -> (Vec<Vertex>, crate::plan::Rejections) {
+    fn vertices(&self, w: &Iso, o: usize, k: usize) -> (Vec<Vertex>, Rejections) {
         let frame = self.world.target_frame(&self.world.layers[o], k);
         let (mut v, mut rej) = self.world.vertices(&self.scene, &w.inverse(), w, &frame, o);
         let need = self.world.opts.clearance;
@@ -721,45 +722,12 @@ fn plan_with_lead(
     let rung_ids: Vec<(usize, usize)> = (0..ctx.layers.len())
         .flat_map(|o| (0..ctx.layers[o].points.len()).map(move |k| (o, k)))
         .collect();
-    let built: Vec<(Vec<Vertex>, crate::plan::Rejections)> = rung_ids
+    let built: Vec<(Vec<Vertex>, Rejections)> = rung_ids
         .par_iter()
         .map(|&(o, k)| geo.vertices(&base.pose_at(sign * (lead + offsets[o][k])), o, k))
         .collect();
-    let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
     let n_cost = if ctx.coaxial { 5 } else { 6 };
-    let vmax = ctx.opts.limits.max_speed();
-    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
-        .map(|r| {
-            let (o0, k0) = rung_ids[r];
-            let (o1, k1) = rung_ids[r + 1];
-            let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
-            let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
-            let dt = (p1 - p0).length() / ctx.opts.print_speed;
-            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
-        })
-        .collect();
-    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
-    let step_cost = |a: &Joints, b: &Joints| -> f64 {
-        let d = joint_delta(a, b);
-        d[..n_cost].iter().map(|v| v * v).sum()
-    };
-    let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
-        let a = &built[r].0[i].q;
-        let b = &built[r + 1].0[j].q;
-        if branch(a) != branch(b) {
-            return None;
-        }
-        let d = joint_delta(a, b);
-        if (0..n_cost).any(|jj| d[jj].abs() > steps[r][jj]) {
-            return None;
-        }
-        let c = step_cost(a, b);
-        (c <= ctx.opts.epsilon).then_some(c)
-    };
-    let result = match ctx.opts.planner {
-        PlannerKind::Optimal => solve_optimal(&sizes, edge),
-        PlannerKind::Random => solve_random(&sizes, edge, ctx.opts.random_trials, ctx.opts.seed),
-    };
+    let result = solve_rungs(ctx, &rung_ids, &built, ctx.opts.seed);
     let path = match result {
         Ok(p) => p,
         Err(LadderFailure::EmptyRung { rung }) => {
@@ -788,42 +756,10 @@ fn plan_with_lead(
             ));
         }
     };
-    let canon: Vec<Joints> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].q)
-        .collect();
-    let clear: Vec<f64> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].clearance)
-        .collect();
     // Unwrap (elbow raw) and one 2π offset per joint, as the station planner.
-    let mut q = canon.clone();
-    for r in 1..canon.len() {
-        let d = joint_delta(&canon[r - 1], &canon[r]);
-        for j in 0..6 {
-            q[r][j] = q[r - 1][j] + d[j];
-        }
-    }
-    let tau = std::f64::consts::TAU;
-    for j in 0..6 {
-        let lo = q.iter().map(|v| v[j]).fold(f64::INFINITY, f64::min);
-        let hi = q.iter().map(|v| v[j]).fold(f64::NEG_INFINITY, f64::max);
-        let mid = 0.5 * (lo + hi);
-        let mut best: Option<f64> = None;
-        for m in -3i32..=3 {
-            let s = f64::from(m) * tau;
-            if lo + s >= ctx.limits[j][0] - 1e-12
-                && hi + s <= ctx.limits[j][1] + 1e-12
-                && best.is_none_or(|b| (mid + s).abs() < (mid + b).abs())
-            {
-                best = Some(s);
-            }
-        }
-        let Some(s) = best else {
+    let (q, clear) = match unwrap_path(ctx, &built, &path) {
+        Ok(p) => p,
+        Err(WindUp { joint: j, lo, hi }) => {
             return Err(fail(
                 0,
                 0,
@@ -833,11 +769,8 @@ fn plan_with_lead(
                     j + 1
                 ),
             ));
-        };
-        for v in &mut q {
-            v[j] += s;
         }
-    }
+    };
     let mut layers_out = Vec::with_capacity(ctx.layers.len());
     let mut travel = Vec::with_capacity(ctx.layers.len());
     let mut r = 0;
@@ -904,15 +837,91 @@ fn plan_with_lead(
 }
 
 /// UR's collision meshes at every waypoint with the base where it is at that moment
-/// ([`crate::meshes::verify_meshes_moving`]), kept in the plan (`Plan::meshes`); a mesh contact
+/// ([`verify_meshes_moving`]), kept in the plan (`Plan::meshes`); a mesh contact
 /// is a failed verification.
 fn attach_moving_meshes(mp: &mut MovingPlan) -> Result<(), RobotError> {
-    let rep = crate::meshes::verify_meshes_moving(mp, 1)?;
+    let rep = verify_meshes_moving(mp, 1)?;
     if !rep.problems.is_empty() {
         return Err(RobotError::Verification(rep.problems));
     }
     mp.plan.meshes = Some(rep);
     Ok(())
+}
+
+/// [`crate::meshes::verify_meshes`] for a base that moves while printing (issue 27): every `stride`-th
+/// waypoint of each layer (and its first and last), the arm posed from the base's pose at that
+/// waypoint ([`MovingPlan::base_pose`]). The environment (beams, floor, printed
+/// layers) stands in the world; the mobile base's own body moves with the arm, so the arm's
+/// distance to it is measured in the base frame, independent of the travel. At the waypoints
+/// only: the clearance along the motion with the base moving is certified on the capsules by
+/// [`check_moving`].
+///
+/// # Errors
+/// An invalid plan (shape, setup, targets) or mesh asset.
+pub fn verify_meshes_moving(
+    mp: &MovingPlan,
+    stride: usize,
+) -> Result<crate::plan::MeshReport, RobotError> {
+    mp.validate_shape()?;
+    let stride = stride.max(1);
+    let plan = &mp.plan;
+    let meshes = crate::meshes::ArmMeshes::load()?;
+    let layers = plan_layers(plan);
+    // The moving check's own split: the world without the body, the body in the base frame.
+    let Geometry {
+        world: ctx,
+        scene: world,
+        body,
+    } = Geometry::new(&validate(&layers, &plan.setup, &plan.options)?)?;
+    let tool_caps: Vec<_> = ctx
+        .self_model
+        .capsules
+        .iter()
+        .filter(|c| c.link == crate::collision::TOOL_LINK)
+        .cloned()
+        .collect();
+    let mut jobs: Vec<(usize, usize, i64, usize, Joints)> = Vec::new();
+    for (o, l) in plan.stations[0].layers.iter().enumerate() {
+        let n = l.waypoints.len();
+        for (k, w) in l.waypoints.iter().enumerate() {
+            if k % stride == 0 || k + 1 == n {
+                jobs.push((o, k, l.layer, w.index, w.q));
+            }
+        }
+    }
+    let out: Vec<crate::meshes::One> = jobs
+        .par_iter()
+        .map(|&(o, k, layer, index, q)| {
+            let probe = crate::meshes::Probe {
+                ctx: &ctx,
+                meshes: &meshes,
+                scene: &world,
+                world_from_base: mp.base_pose(o, k),
+                tool_caps: &tool_caps,
+            };
+            let mut one = probe.measure(&q, o);
+            if let Some(body) = &body {
+                let on_base = crate::meshes::Probe {
+                    scene: body,
+                    world_from_base: Iso::IDENTITY,
+                    ..probe
+                };
+                let b = on_base.measure(&q, o);
+                for (mine, theirs) in [
+                    (&mut one.cap_env, b.cap_env),
+                    (&mut one.nozzle, b.nozzle),
+                    (&mut one.mesh_env, b.mesh_env),
+                ] {
+                    if theirs.0 < mine.0 {
+                        *mine = theirs;
+                    }
+                }
+            }
+            one.at = (0, layer, index);
+            one
+        })
+        .collect();
+    Ok(crate::meshes::report_of(&out, &meshes, None))
 }
 
 /// The base trajectory of a timed plan: a sample at the start of the clock (the approach, base
@@ -1018,7 +1027,7 @@ pub fn check_moving(mp: &MovingPlan) -> MovingCheck {
         return rep;
     }
     let plan = &mp.plan;
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
@@ -1297,7 +1306,7 @@ pub fn check_moving_tolerance(
     mp: &MovingPlan,
     tol: &crate::tolerance::BaseTolerance,
 ) -> crate::tolerance::ToleranceReport {
-    use crate::tolerance::{ToleranceReport, sampled_errors};
+    use crate::tolerance::{Resolver, ToleranceReport, sampled_errors};
     let mut rep = ToleranceReport {
         tolerance: tol.clone(),
         min_clearance: f64::INFINITY,
@@ -1320,7 +1329,7 @@ pub fn check_moving_tolerance(
         return rep;
     }
     let plan = &mp.plan;
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
@@ -1342,7 +1351,6 @@ pub fn check_moving_tolerance(
     let jobs: Vec<(usize, (f64, f64, f64))> = (0..st.layers.len())
         .flat_map(|li| errors.iter().map(move |e| (li, *e)))
         .collect();
-    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
     let results: Vec<(usize, f64, Vec<String>)> = jobs
         .par_iter()
         .map(|&(li, (dx, dy, da))| {
@@ -1364,45 +1372,15 @@ pub fn check_moving_tolerance(
                 pr.push(format!("{at}: {e}"));
             }
             let len = l.waypoints.len();
-            let mut prev: Option<Joints> = None;
+            let mut resolver = Resolver::new(eps, tol.stride, len);
             for (k, w) in l.waypoints.iter().enumerate() {
                 if k % tol.stride != 0 && k + 1 != len {
                     continue;
                 }
                 n += 1;
                 let (verts, rej) = geo.vertices(&off(k), li, k);
-                let best = verts
-                    .iter()
-                    .filter(|v| branch(&v.q) == branch(&w.q))
-                    .map(|v| {
-                        let d2: f64 = joint_delta(&w.q, &v.q).iter().map(|d| d * d).sum();
-                        (d2, v)
-                    })
-                    .min_by(|a, b| a.0.total_cmp(&b.0));
-                match best {
-                    None => {
-                        pr.push(format!(
-                            "{at}: point {} has no valid configuration on the planned branch ({})",
-                            w.index,
-                            rej.failure().1
-                        ));
-                        prev = None;
-                    }
-                    Some((_, v)) => {
-                        min_c = min_c.min(v.clearance);
-                        if let Some(p) = prev {
-                            let step: f64 = joint_delta(&p, &v.q).iter().map(|d| d * d).sum();
-                            let allowed = eps * (tol.stride.min(len) as f64).powi(2);
-                            if step > allowed {
-                                pr.push(format!(
-                                    "{at}: point {}: the re-solved joints jump by Σ Δq² = {step:.4} rad² (> {allowed:.4})",
-                                    w.index
-                                ));
-                            }
-                        }
-                        prev = Some(v.q);
-                    }
-                }
+                let point = format!("{at}: point {}", w.index);
+                resolver.next(&w.q, &verts, &rej, &point, &mut min_c, &mut pr);
             }
             (n, min_c, pr)
         })

@@ -1,23 +1,14 @@
-//! Planning a print: target frames along each layer, IK vertices filtered by limits, singularity
-//! margins, self-collision and clearance, then the ladder search ([`crate::ladder`]) over a whole
-//! station (layers joined by `movej` transitions), 2π unwrapping, timing at the print speed and a
-//! collision check of every transition. Base stations come from [`crate::base`].
-//!
-//! Edge rules inside a layer (robot.md §3.6): Σ Δq² ≤ ε (the paper's compatibility),
-//! |Δq_j| ≤ s·v_j,max·Δt with Δt = |Δp|/v_print, and the elbow and wrist branches
-//! (sign sin q3, sign sin q5) unchanged. Edge cost Σ Δq² (Δq wrapped except the elbow; q6 left out
-//! for a coaxial tool, whose q6 is held constant).
+//! The plan's data: what a planned print is (stations of timed layers of waypoints) and what it
+//! carries (program parts, slowdowns, mesh and certified clearances, the operator's mark). Plain
+//! data, serialised to `plan.json`; the planning that makes it is in [`crate::planner`] and
+//! [`crate::stationary`], the checks and the timing that fill it in [`crate::check`],
+//! [`crate::timing`] and [`crate::meshes`].
 
-use parry3d_f64::glamx::DVec3;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::collision::{CapsuleSpec, LINK_NAMES, Obstacle, RobotModel, Scene, TOOL_LINK};
-use crate::error::{FailureKind, PlanFailure, RobotError};
-use crate::frames::{Iso, Mat4, frame_from_z};
-use crate::kinematics::{Joints, UR10E, joint_delta, representable_in_limits};
-use crate::ladder::{LadderFailure, solve_optimal, solve_random};
-use crate::setup::{BasePlacement, PlanOptions, PlannerKind, PrintLayer, RobotSetup};
+use crate::frames::Mat4;
+use crate::kinematics::Joints;
+use crate::setup::{PathPoint, PlanOptions, PrintLayer, RobotSetup};
 
 /// Clearances above this (m) are reported as this value.
 pub const CLEARANCE_CUTOFF: f64 = 0.5;
@@ -117,14 +108,14 @@ pub struct Plan {
     pub max_acceleration_ratio: f64,
     /// Where the tool is slower than the design speed (the flow follows it).
     #[serde(default)]
-    pub slowdowns: Vec<crate::timing::Slowdown>,
+    pub slowdowns: Vec<Slowdown>,
     /// The program files, in order.
     #[serde(default)]
-    pub parts: Vec<crate::program::ProgramPart>,
+    pub parts: Vec<ProgramPart>,
     /// Clearances measured with UR's collision meshes and with the capsules, when checked
     /// ([`crate::meshes::attach_mesh_report`]).
     #[serde(default)]
-    pub meshes: Option<crate::meshes::MeshReport>,
+    pub meshes: Option<MeshReport>,
     /// Certified capsule clearances along the motion from the plan's check
     /// ([`crate::check::CheckReport`]), when checked.
     #[serde(default)]
@@ -229,18 +220,6 @@ pub struct CertifiedClearance {
     pub configurations: usize,
 }
 
-impl CertifiedClearance {
-    /// The certified values of a check report.
-    pub fn of(rep: &crate::check::CheckReport) -> Self {
-        CertifiedClearance {
-            clearance: rep.certified_clearance,
-            approach_clearance: rep.certified_approach_clearance,
-            self_distance: rep.certified_self_distance,
-            configurations: rep.certified_configurations,
-        }
-    }
-}
-
 impl Plan {
     /// Number of print waypoints.
     pub fn waypoint_count(&self) -> usize {
@@ -252,917 +231,110 @@ impl Plan {
     }
 }
 
-/// Geometry shared by all stations: models, static scene, tool.
-pub(crate) struct Context {
-    pub self_model: RobotModel,
-    pub env_model: RobotModel,
-    pub flange_from_tcp: Iso,
-    pub tcp_from_flange: Iso,
-    pub coaxial: bool,
-    pub opts: PlanOptions,
-    pub setup: RobotSetup,
-    pub layers: Vec<PrintLayer>,
-    /// Joint position limits (rad), validated.
-    pub limits: [[f64; 2]; 6],
-}
-
-/// Clip a tool capsule to the part at least `excl` behind the tip along the tool axis.
-fn clip_tool_capsule(c: &CapsuleSpec, tip: DVec3, axis: DVec3, excl: f64) -> Option<CapsuleSpec> {
-    let a = DVec3::from(c.a);
-    let b = DVec3::from(c.b);
-    let sa = (tip - a).dot(axis);
-    let sb = (tip - b).dot(axis);
-    if sa < excl && sb < excl {
-        return None;
-    }
-    let cut = |p: DVec3, sp: f64, q: DVec3, sq: f64| p + (q - p) * ((sp - excl) / (sp - sq));
-    let (na, nb) = if sa < excl {
-        (cut(b, sb, a, sa), b)
-    } else if sb < excl {
-        (a, cut(a, sa, b, sb))
-    } else {
-        (a, b)
-    };
-    Some(CapsuleSpec {
-        a: na.to_array(),
-        b: nb.to_array(),
-        ..c.clone()
-    })
-}
-
-pub(crate) fn validate(
-    layers: &[PrintLayer],
-    setup: &RobotSetup,
-    opts: &PlanOptions,
-) -> Result<Context, RobotError> {
-    let pos = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
-            Ok(())
-        } else {
-            Err(RobotError::invalid(
-                name,
-                format!("{v}: must be finite and > 0"),
-            ))
-        }
-    };
-    pos("epsilon (rad²)", opts.epsilon)?;
-    pos("print_speed (m/s)", opts.print_speed)?;
-    pos("transition_speed_fraction", opts.transition_speed_fraction)?;
-    if !(opts.speed_fraction > 0.0 && opts.speed_fraction <= 1.0) {
-        return Err(RobotError::invalid(
-            "speed_fraction",
-            format!("{}: must be in (0, 1]", opts.speed_fraction),
-        ));
-    }
-    for (name, v) in [
-        ("clearance (m)", opts.clearance),
-        ("self_clearance (m)", opts.self_clearance),
-        ("min_abs_sin_q5", opts.min_abs_sin_q5),
-        ("min_abs_sin_q3", opts.min_abs_sin_q3),
-        ("min_shoulder_margin (m)", opts.min_shoulder_margin),
-        ("bead_radius (m)", opts.bead_radius),
-        ("tool.tip_exclusion (m)", setup.tool.tip_exclusion),
-        ("station_change_time (s)", opts.station_change_time),
-        ("reconfiguration_penalty", opts.reconfiguration_penalty),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(RobotError::invalid(
-                name,
-                format!("{v}: must be finite and ≥ 0"),
-            ));
-        }
-    }
-    if !opts.bead_offset.is_finite()
-        || !opts.q6.is_finite()
-        || opts.q6.abs() > std::f64::consts::TAU
-    {
-        return Err(RobotError::invalid(
-            "bead_offset / q6",
-            format!(
-                "{} / {}: must be finite, |q6| ≤ 2π",
-                opts.bead_offset, opts.q6
-            ),
-        ));
-    }
-    let pr = &opts.program;
-    if pr.max_moves_per_program < 4 {
-        return Err(RobotError::invalid(
-            "program.max_moves_per_program",
-            format!(
-                "{}: a program needs at least 4 targets (approach, descent, a print move, retract)",
-                pr.max_moves_per_program
-            ),
-        ));
-    }
-    pos("program.approach_distance (m)", pr.approach_distance)?;
-    pos("program.approach_speed (m/s)", pr.approach_speed)?;
-    pos("program.tool_acceleration (m/s²)", pr.tool_acceleration)?;
-    pos("program.joint_speed (rad/s)", pr.joint_speed)?;
-    pos("program.joint_acceleration (rad/s²)", pr.joint_acceleration)?;
-    for (name, v) in [
-        ("program.blend_radius (m)", pr.blend_radius),
-        ("program.program_switch_time (s)", pr.program_switch_time),
-        ("program.payload_mass (kg)", pr.payload_mass),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(RobotError::invalid(
-                name,
-                format!("{v}: must be finite and ≥ 0"),
-            ));
-        }
-    }
-    if !pr.payload_cog.iter().all(|v| v.is_finite()) {
-        return Err(RobotError::invalid(
-            "program.payload_cog (m)",
-            format!("{:?}: must be finite", pr.payload_cog),
-        ));
-    }
-    opts.limits.validate_positions()?;
-    for j in 0..6 {
-        let (v, a) = (
-            opts.limits.max_speed_deg_s[j],
-            opts.limits.max_acceleration[j],
-        );
-        if !(v.is_finite() && v > 0.0 && a.is_finite() && a > 0.0) {
-            return Err(RobotError::invalid(
-                format!("limits (joint {})", j + 1),
-                format!("speed {v} °/s, acceleration {a} rad/s²: must be finite and > 0"),
-            ));
-        }
-    }
-    // Flow at the design speed: Q = lw·lh·v with lw = 2·bead_radius, lh = 2·bead_offset.
-    opts.pump
-        .validate(4.0 * opts.bead_radius * opts.bead_offset.abs() * opts.print_speed)?;
-    if opts.rotation_steps == 0 || opts.rotation_steps > 360 {
-        return Err(RobotError::invalid(
-            "rotation_steps",
-            format!("{}: must be 1..=360", opts.rotation_steps),
-        ));
-    }
-    if opts.planner == PlannerKind::Random && opts.random_trials == 0 {
-        return Err(RobotError::invalid(
-            "random_trials",
-            "0: need at least 1 trial",
-        ));
-    }
-    let flange_from_tcp = Iso::from_mat4(&setup.tool.flange_from_tcp)
-        .map_err(|e| RobotError::invalid("tool.flange_from_tcp", e))?;
-    if flange_from_tcp.t.length() < 1e-6 {
-        return Err(RobotError::invalid(
-            "tool.flange_from_tcp",
-            format!(
-                "TCP offset {:?} m: a tool of zero length cannot hold a nozzle",
-                flange_from_tcp.t.to_array()
-            ),
-        ));
-    }
-    if layers.is_empty() {
-        return Err(RobotError::invalid("layers", "no layer to plan"));
-    }
-    let mut cleaned = layers.to_vec();
-    for (li, l) in cleaned.iter_mut().enumerate() {
-        if l.points.is_empty() {
-            return Err(RobotError::invalid(
-                format!("layers[{li}] (layer {})", l.layer),
-                "has no point",
-            ));
-        }
-        for p in &mut l.points {
-            let field = || format!("layer {} point {}", l.layer, p.index);
-            if !p.position.iter().chain(&p.axis).all(|v| v.is_finite()) {
-                return Err(RobotError::invalid(field(), "non-finite position or axis"));
-            }
-            let a = DVec3::from(p.axis);
-            if (a.length() - 1.0).abs() > 1e-3 {
-                return Err(RobotError::invalid(
-                    field(),
-                    format!(
-                        "tool axis {:?} has length {:.6}, expected a unit vector",
-                        p.axis,
-                        a.length()
-                    ),
-                ));
-            }
-            p.axis = a.normalize().to_array();
-        }
-    }
-    // Tool capsules: full for self-collision, clipped near the tip for the environment.
-    let tip = flange_from_tcp.t;
-    let axis = flange_from_tcp.r.z_axis;
-    let tool_specs: Vec<CapsuleSpec> = setup
-        .tool
-        .capsules
+/// The print targets of a plan as the planner's input layers (every station's layers in print
+/// order), so a check can validate them with the planner's own rules.
+pub(crate) fn plan_layers(plan: &Plan) -> Vec<PrintLayer> {
+    plan.stations
         .iter()
-        .enumerate()
-        .map(|(i, c)| CapsuleSpec {
-            link: TOOL_LINK,
-            name: format!("tool_{i}"),
-            a: c.a,
-            b: c.b,
-            radius: c.radius,
+        .flat_map(|s| &s.layers)
+        .map(|l| PrintLayer {
+            layer: l.layer,
+            points: l
+                .waypoints
+                .iter()
+                .map(|w| PathPoint {
+                    index: w.index,
+                    position: w.position,
+                    axis: w.axis,
+                })
+                .collect(),
         })
-        .collect();
-    let self_model = RobotModel::ur10e_with_tool(&tool_specs)?;
-    let mut env_caps: Vec<CapsuleSpec> = crate::collision::ur10e_arm_capsules()
-        .into_iter()
-        .filter(|c| c.link != 0)
-        .collect();
-    env_caps.extend(
-        tool_specs
-            .iter()
-            .filter_map(|c| clip_tool_capsule(c, tip, axis, setup.tool.tip_exclusion)),
-    );
-    let env_model = RobotModel::new(UR10E, env_caps, Vec::new())?;
-    // Coaxial: the tool axis is the flange z axis through the flange centre and every tool
-    // capsule lies on it, so a rotation about the tool axis is exactly a change of q6.
-    let on_axis = |p: [f64; 3]| p[0].abs() < 1e-9 && p[1].abs() < 1e-9;
-    let coaxial = (axis - DVec3::Z).length() < 1e-9
-        && tip.x.abs() < 1e-9
-        && tip.y.abs() < 1e-9
-        && setup
-            .tool
-            .capsules
-            .iter()
-            .all(|c| on_axis(c.a) && on_axis(c.b));
-    Ok(Context {
-        self_model,
-        env_model,
-        flange_from_tcp,
-        tcp_from_flange: flange_from_tcp.inverse(),
-        coaxial,
-        opts: opts.clone(),
-        setup: setup.clone(),
-        layers: cleaned,
-        limits: opts.limits.position(),
-    })
+        .collect()
 }
 
-/// A valid configuration of one frame.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Vertex {
-    pub q: Joints,
-    pub clearance: f64,
+/// A range of consecutive print moves that is slower than the design speed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Slowdown {
+    pub station: usize,
+    /// Layer and point index of the first and last waypoint reached by a slow move.
+    pub from: (i64, usize),
+    pub to: (i64, usize),
+    /// Lowest tool speed / design speed in the range.
+    pub min_speed_ratio: f64,
+    /// Why: "joint speed (joint j)" or "joint acceleration".
+    pub reason: String,
 }
 
-/// Why the candidates of a frame were dropped.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Rejections {
-    pub ik: usize,
-    pub limits: usize,
-    pub singular: usize,
-    pub self_collision: usize,
-    pub collision: usize,
-    pub self_example: Option<(usize, usize)>,
-    pub collision_example: Option<(usize, String, f64)>,
+/// One program file: a contiguous range of layers of one station.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ProgramPart {
+    pub station: usize,
+    /// Layer slots (indices into the station's `layers`), inclusive.
+    pub first: usize,
+    pub last: usize,
+    /// Their layer ids.
+    pub first_layer: i64,
+    pub last_layer: i64,
+    /// Motion targets (move commands) in the file.
+    pub targets: usize,
+    /// The part starts the station: approach from the safe pose and prime the pump.
+    pub starts_station: bool,
+    /// The part ends the station: pump off and retract.
+    pub ends_station: bool,
 }
 
-impl Rejections {
-    pub fn failure(&self) -> (FailureKind, String) {
-        if self.ik == 0 {
-            return (
-                FailureKind::Unreachable,
-                "no IK solution: the target is out of reach".into(),
-            );
-        }
-        let mut detail = format!(
-            "{} IK solutions: {} outside joint limits, {} near a singularity, {} self-colliding, {} too close to the environment",
-            self.ik, self.limits, self.singular, self.self_collision, self.collision
-        );
-        if let Some((a, b)) = self.self_example {
-            detail += &format!("; self collision {}–{}", LINK_NAMES[a], LINK_NAMES[b]);
-        }
-        if let Some((l, o, d)) = &self.collision_example {
-            detail += &format!("; {} within {:.4} m of {o:?}", LINK_NAMES[*l], d);
-        }
-        let kind = if self.collision > 0 {
-            FailureKind::Collision
-        } else if self.self_collision > 0 {
-            FailureKind::SelfCollision
-        } else if self.singular > 0 {
-            FailureKind::Singularity
-        } else {
-            FailureKind::JointLimits
-        };
-        (kind, detail)
-    }
+/// Environment clearances of the meshes above this (m) are reported as this value.
+pub const MESH_CUTOFF: f64 = 0.1;
+
+/// Where a model's smallest clearance or self distance occurs.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ClearanceAt {
+    /// Metres (0 = touching or overlapping for the meshes; negative = overlap depth for capsules).
+    pub distance: f64,
+    pub station: usize,
+    pub layer: i64,
+    pub index: usize,
+    /// Link or link pair, and the object.
+    pub what: String,
 }
 
-impl Context {
-    /// TCP frame of a target (φ = 0), world: z = tool axis, x from the path tangent.
-    pub fn target_frame(&self, layer: &PrintLayer, k: usize) -> Iso {
-        let pts = &layer.points;
-        let p = DVec3::from(pts[k].position);
-        let prev = DVec3::from(pts[k.saturating_sub(1)].position);
-        let next = DVec3::from(pts[(k + 1).min(pts.len() - 1)].position);
-        let mut tangent = next - prev;
-        if tangent.length_squared() < 1e-18 {
-            tangent = DVec3::X;
-        }
-        frame_from_z(p, DVec3::from(pts[k].axis), tangent)
-    }
-
-    /// Singularity margins hold for `q` at flange pose `base_from_flange`.
-    pub fn margins_ok(&self, q: &Joints, base_from_flange: &Iso) -> bool {
-        q[4].sin().abs() >= self.opts.min_abs_sin_q5
-            && q[2].sin().abs() >= self.opts.min_abs_sin_q3
-            && UR10E.shoulder_margin(base_from_flange) >= self.opts.min_shoulder_margin
-    }
-
-    /// All valid vertices of a world TCP frame for base `world_from_base`; printed layers with
-    /// print order < `order` are obstacles.
-    pub fn vertices(
-        &self,
-        scene: &Scene,
-        base_from_world: &Iso,
-        world_from_base: &Iso,
-        world_tcp: &Iso,
-        order: usize,
-    ) -> (Vec<Vertex>, Rejections) {
-        self.vertices_upto(
-            scene,
-            base_from_world,
-            world_from_base,
-            world_tcp,
-            order,
-            usize::MAX,
-        )
-    }
-
-    /// Whether a world TCP frame has any valid vertex ([`Self::vertices`] is non-empty): stops at
-    /// the first one and measures clearances only up to the required clearance (a vertex is
-    /// valid iff its clearance capped at any cutoff ≥ `clearance` is ≥ `clearance`), so the base
-    /// search's scoring does a fraction of the distance queries.
-    pub fn has_vertex(
-        &self,
-        scene: &Scene,
-        base_from_world: &Iso,
-        world_from_base: &Iso,
-        world_tcp: &Iso,
-        order: usize,
-    ) -> bool {
-        !self
-            .vertices_upto(scene, base_from_world, world_from_base, world_tcp, order, 1)
-            .0
-            .is_empty()
-    }
-
-    /// The valid vertices, at most `max` of them; with `max < usize::MAX` clearances are
-    /// measured only up to the required clearance (see [`Self::has_vertex`]).
-    fn vertices_upto(
-        &self,
-        scene: &Scene,
-        base_from_world: &Iso,
-        world_from_base: &Iso,
-        world_tcp: &Iso,
-        order: usize,
-        max: usize,
-    ) -> (Vec<Vertex>, Rejections) {
-        let cutoff = if max == usize::MAX {
-            CLEARANCE_CUTOFF
-        } else {
-            self.opts.clearance.min(CLEARANCE_CUTOFF)
-        };
-        let mut rej = Rejections::default();
-        let mut out = Vec::new();
-        let n_rot = if self.coaxial {
-            1
-        } else {
-            self.opts.rotation_steps
-        };
-        for r in 0..n_rot {
-            let phi = std::f64::consts::TAU * r as f64 / n_rot as f64;
-            let base_tcp = base_from_world.mul(world_tcp).mul(&Iso::rot_z(phi));
-            let base_flange = base_tcp.mul(&self.tcp_from_flange);
-            let sols = UR10E.ik(&base_flange);
-            for q0 in sols.as_slice() {
-                rej.ik += 1;
-                let mut q = *q0;
-                if self.coaxial {
-                    q[5] = self.opts.q6;
-                }
-                if !representable_in_limits(&q, &self.limits) {
-                    rej.limits += 1;
-                    continue;
-                }
-                if !self.margins_ok(&q, &base_flange) {
-                    rej.singular += 1;
-                    continue;
-                }
-                let posed = self.self_model.pose(&q, &Iso::IDENTITY);
-                let (ds, pair) = self.self_model.min_self_distance_posed(&posed);
-                if ds < self.opts.self_clearance {
-                    rej.self_collision += 1;
-                    rej.self_example.get_or_insert(pair);
-                    continue;
-                }
-                let env = self.env_model.pose(&q, world_from_base);
-                let c = scene.clearance(env.as_slice(), order, cutoff);
-                if c.distance < self.opts.clearance {
-                    rej.collision += 1;
-                    if rej.collision_example.is_none() {
-                        rej.collision_example =
-                            Some((c.link, c.object.unwrap_or_default(), c.distance));
-                    }
-                    continue;
-                }
-                out.push(Vertex {
-                    q,
-                    clearance: c.distance,
-                });
-                if out.len() >= max {
-                    return (out, rej);
-                }
-            }
-        }
-        (out, rej)
-    }
-
-    /// The scene for one base pose: static obstacles, floor, mobile base body, printed layers.
-    pub fn scene(&self, world_from_base: &Iso) -> Result<Scene, RobotError> {
-        let mut obstacles: Vec<Obstacle> = self.setup.obstacles.clone();
-        if let Some(z) = self.setup.floor_z {
-            obstacles.push(Obstacle::HalfSpace {
-                name: "floor".into(),
-                point: [0.0, 0.0, z],
-                normal: [0.0, 0.0, 1.0],
-            });
-        }
-        for b in &self.setup.mobile_base {
-            obstacles.push(b.to_world(world_from_base));
-        }
-        let mut scene = Scene::new(&obstacles)?;
-        if self.opts.printed_layers_as_obstacles {
-            for (order, l) in self.layers.iter().enumerate() {
-                let pts: Vec<DVec3> = l
-                    .points
-                    .iter()
-                    .map(|p| DVec3::from(p.position) + DVec3::from(p.axis) * self.opts.bead_offset)
-                    .collect();
-                scene.add_printed_layer(
-                    order,
-                    format!("printed layer {}", l.layer),
-                    &pts,
-                    self.opts.bead_radius,
-                );
-            }
-        }
-        Ok(scene)
-    }
-
-    /// Check the base pose itself: the arm base and the mobile base clear of static obstacles
-    /// and of the print.
-    pub fn check_base(&self, world_from_base: &Iso) -> Result<(), String> {
-        let statics = Scene::new(&self.setup.obstacles).map_err(|e| e.to_string())?;
-        let base_caps: Vec<_> = self
-            .self_model
-            .pose(&[0.0; 6], world_from_base)
-            .as_slice()
-            .iter()
-            .copied()
-            .filter(|c| c.link == 0)
-            .collect();
-        let c = statics.clearance(&base_caps, 0, CLEARANCE_CUTOFF);
-        if c.distance < 0.0 + 1e-12 && c.object.is_some() {
-            return Err(format!(
-                "the robot base is inside {:?}",
-                c.object.unwrap_or_default()
-            ));
-        }
-        for b in &self.setup.mobile_base {
-            let Obstacle::Box {
-                center,
-                half_extents,
-                yaw,
-                ..
-            } = b.to_world(world_from_base)
-            else {
-                continue;
-            };
-            // Box vs statics: represent the body by its inscribed capsule along its longest axis
-            // would miss corners; use parry on the box through a one-object scene instead.
-            let body = Scene::new(&[Obstacle::Box {
-                name: b.name.clone(),
-                center,
-                half_extents,
-                yaw,
-            }])
-            .map_err(|e| e.to_string())?;
-            for o in &self.setup.obstacles {
-                if let Some(d) = body.distance_to(o)
-                    && d <= 0.0
-                {
-                    return Err(format!(
-                        "the mobile base body {:?} overlaps {:?}",
-                        b.name,
-                        o.name()
-                    ));
-                }
-            }
-            // No print target may lie inside the body (the cap is not under the robot).
-            let inv = world_from_base.inverse();
-            for l in &self.layers {
-                for p in &l.points {
-                    let local = inv.point(DVec3::from(p.position)) - DVec3::from(b.center);
-                    let h = DVec3::from(b.half_extents);
-                    if local.abs().cmple(h).all() {
-                        return Err(format!(
-                            "the mobile base body {:?} covers layer {} point {}",
-                            b.name, l.layer, p.index
-                        ));
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
+/// Clearance of one geometric model over the checked waypoints.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ModelClearance {
+    /// Smallest distance of the arm (links 1–6) to the environment (beams, mobile base, floor,
+    /// printed layers), capped at [`MESH_CUTOFF`].
+    pub environment: ClearanceAt,
+    /// Smallest distance of the 13 self-collision pairs.
+    pub self_distance: ClearanceAt,
 }
 
-/// Plan a station: layers `range` (print order) from `world_from_base`; `t0` is the start time.
-pub(crate) fn plan_station(
-    ctx: &Context,
-    station: usize,
-    world_from_base: &Iso,
-    range: std::ops::Range<usize>,
-    t0: f64,
-) -> Result<Station, Box<PlanFailure>> {
-    let mut cache = None;
-    plan_station_cached(ctx, station, world_from_base, range, t0, &mut cache)
+/// The plan measured with the capsules and with UR's collision meshes.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MeshReport {
+    pub waypoints_checked: usize,
+    pub mesh_vertices: Vec<usize>,
+    pub capsules: ModelClearance,
+    pub meshes: ModelClearance,
+    /// The nozzle (a capsule in both models, clipped near the tip) to the environment.
+    pub nozzle: ClearanceAt,
+    /// Certified smallest clearances of the meshes between the waypoints (joint-interpolated
+    /// print moves and layer changes; [`crate::sweep`]), when measured.
+    #[serde(default)]
+    pub along_motion: Option<AlongMotion>,
+    /// Mesh contacts (distance 0 to the environment or on a self pair).
+    pub problems: Vec<String>,
 }
 
-/// The valid vertices of every rung of layers `start..` built for one base pose; a retry of the
-/// same pose over a shorter range (after a failure) reuses them.
-pub(crate) type RungCache = Option<(usize, Vec<(Vec<Vertex>, Rejections)>)>;
-
-/// [`plan_station`] reusing (or filling) `cache` for this base pose and `range.start`.
-pub(crate) fn plan_station_cached(
-    ctx: &Context,
-    station: usize,
-    world_from_base: &Iso,
-    range: std::ops::Range<usize>,
-    t0: f64,
-    cache: &mut RungCache,
-) -> Result<Station, Box<PlanFailure>> {
-    let base_from_world = world_from_base.inverse();
-    let fail = |layer: i64, index: usize, kind: FailureKind, detail: String| {
-        Box::new(PlanFailure {
-            station,
-            layer,
-            index,
-            kind,
-            detail,
-        })
-    };
-    if let Err(e) = ctx.check_base(world_from_base) {
-        let l = &ctx.layers[range.start];
-        return Err(fail(
-            l.layer,
-            l.points[0].index,
-            FailureKind::BasePlacement,
-            e,
-        ));
-    }
-    let scene = ctx
-        .scene(world_from_base)
-        .map_err(|e| fail(0, 0, FailureKind::BasePlacement, e.to_string()))?;
-    // Rungs: (order, k) for every point of every layer of the station.
-    let rung_ids: Vec<(usize, usize)> = range
-        .clone()
-        .flat_map(|o| (0..ctx.layers[o].points.len()).map(move |k| (o, k)))
-        .collect();
-    let usable =
-        matches!(cache, Some((start, b)) if *start == range.start && b.len() >= rung_ids.len());
-    if !usable {
-        let built: Vec<(Vec<Vertex>, Rejections)> = rung_ids
-            .par_iter()
-            .map(|&(o, k)| {
-                let frame = ctx.target_frame(&ctx.layers[o], k);
-                ctx.vertices(&scene, &base_from_world, world_from_base, &frame, o)
-            })
-            .collect();
-        *cache = Some((range.start, built));
-    }
-    let built: &[(Vec<Vertex>, Rejections)] = match cache {
-        Some((_, b)) => &b[..rung_ids.len()],
-        None => &[],
-    };
-    let sizes: Vec<usize> = built.iter().map(|b| b.0.len()).collect();
-    let n_cost = if ctx.coaxial { 5 } else { 6 };
-    // Allowed joint step per rung boundary. The layer change is a printed move like any other
-    // (continuous extrusion), so the same speed, ε and branch rules hold across it.
-    let vmax = ctx.opts.limits.max_speed();
-    let steps: Vec<[f64; 6]> = (0..rung_ids.len().saturating_sub(1))
-        .map(|r| {
-            let (o0, k0) = rung_ids[r];
-            let (o1, k1) = rung_ids[r + 1];
-            let p0 = DVec3::from(ctx.layers[o0].points[k0].position);
-            let p1 = DVec3::from(ctx.layers[o1].points[k1].position);
-            let dt = (p1 - p0).length() / ctx.opts.print_speed;
-            std::array::from_fn(|j| ctx.opts.speed_fraction * vmax[j] * dt)
-        })
-        .collect();
-    let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
-    let step_cost = |a: &Joints, b: &Joints| -> f64 {
-        let d = joint_delta(a, b);
-        d[..n_cost].iter().map(|v| v * v).sum()
-    };
-    let edge = |r: usize, i: usize, j: usize| -> Option<f64> {
-        let a = &built[r].0[i].q;
-        let b = &built[r + 1].0[j].q;
-        let lim = &steps[r];
-        if branch(a) != branch(b) {
-            return None;
-        }
-        let d = joint_delta(a, b);
-        if (0..n_cost).any(|j| d[j].abs() > lim[j]) {
-            return None;
-        }
-        let c = step_cost(a, b);
-        (c <= ctx.opts.epsilon).then_some(c)
-    };
-    let result = match ctx.opts.planner {
-        PlannerKind::Optimal => solve_optimal(&sizes, edge),
-        PlannerKind::Random => solve_random(
-            &sizes,
-            edge,
-            ctx.opts.random_trials,
-            ctx.opts.seed.wrapping_add(station as u64),
-        ),
-    };
-    let path = match result {
-        Ok(p) => p,
-        Err(LadderFailure::EmptyRung { rung }) => {
-            let (o, k) = rung_ids[rung];
-            let (kind, detail) = built[rung].1.failure();
-            return Err(fail(
-                ctx.layers[o].layer,
-                ctx.layers[o].points[k].index,
-                kind,
-                detail,
-            ));
-        }
-        Err(LadderFailure::NoEdge { rung }) => {
-            let (o, k) = rung_ids[rung];
-            let mut best = f64::INFINITY;
-            for a in &built[rung - 1].0 {
-                for b in &built[rung].0 {
-                    best = best.min(step_cost(&a.q, &b.q));
-                }
-            }
-            let detail = format!(
-                "{} valid configurations here, {} at the previous point, but no step satisfies Σ Δq² ≤ ε = {} with unchanged elbow/wrist branch and joint speeds ≤ {} of the limits at {} m/s (smallest Σ Δq² between them {best:.4} rad²)",
-                built[rung].0.len(),
-                built[rung - 1].0.len(),
-                ctx.opts.epsilon,
-                ctx.opts.speed_fraction,
-                ctx.opts.print_speed
-            );
-            return Err(fail(
-                ctx.layers[o].layer,
-                ctx.layers[o].points[k].index,
-                FailureKind::NoCompatibleNeighbour,
-                detail,
-            ));
-        }
-    };
-    // Canonical path, then unwrap (elbow raw) and choose one 2π offset per joint.
-    let canon: Vec<Joints> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].q)
-        .collect();
-    let clear: Vec<f64> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].clearance)
-        .collect();
-    let mut unwrapped = canon.clone();
-    for r in 1..canon.len() {
-        let d = joint_delta(&canon[r - 1], &canon[r]);
-        for j in 0..6 {
-            unwrapped[r][j] = unwrapped[r - 1][j] + d[j];
-        }
-    }
-    for j in 0..6 {
-        let lo = unwrapped.iter().map(|q| q[j]).fold(f64::INFINITY, f64::min);
-        let hi = unwrapped
-            .iter()
-            .map(|q| q[j])
-            .fold(f64::NEG_INFINITY, f64::max);
-        let mid = 0.5 * (lo + hi);
-        let tau = std::f64::consts::TAU;
-        let mut best: Option<f64> = None;
-        for m in -3i32..=3 {
-            let s = f64::from(m) * tau;
-            if lo + s >= ctx.limits[j][0] - 1e-12 && hi + s <= ctx.limits[j][1] + 1e-12 {
-                let better = best.is_none_or(|b| (mid + s).abs() < (mid + b).abs());
-                if better {
-                    best = Some(s);
-                }
-            }
-        }
-        let Some(s) = best else {
-            let l = &ctx.layers[range.start];
-            return Err(fail(
-                l.layer,
-                l.points[0].index,
-                FailureKind::WindUp,
-                format!(
-                    "joint {} travels from {lo:.3} to {hi:.3} rad, more than its range {:?}",
-                    j + 1,
-                    ctx.limits[j]
-                ),
-            ));
-        };
-        for q in &mut unwrapped {
-            q[j] += s;
-        }
-    }
-    // Layer summaries and collision checks of the joint-interpolated layer changes; the times
-    // come later from [`crate::timing`], once the whole plan is known.
-    let mut layers_out = Vec::new();
-    let mut r = 0;
-    let mut prev_q: Option<Joints> = None;
-    for o in range.clone() {
-        let layer = &ctx.layers[o];
-        if let Some(pq) = prev_q {
-            let q1 = unwrapped[r];
-            if let Some(msg) = transition_collision(ctx, &scene, world_from_base, &pq, &q1, o) {
-                return Err(fail(
-                    layer.layer,
-                    layer.points[0].index,
-                    FailureKind::Transition,
-                    msg,
-                ));
-            }
-        }
-        let mut wps = Vec::with_capacity(layer.points.len());
-        let (mut cost, mut min_c) = (0.0, f64::INFINITY);
-        for (k, p) in layer.points.iter().enumerate() {
-            let q = unwrapped[r];
-            if k > 0 {
-                let dq: Vec<f64> = (0..6).map(|j| q[j] - unwrapped[r - 1][j]).collect();
-                cost += dq[..n_cost].iter().map(|v| v * v).sum::<f64>();
-            }
-            min_c = min_c.min(clear[r]);
-            wps.push(Waypoint {
-                index: p.index,
-                t: t0,
-                q,
-                position: p.position,
-                axis: p.axis,
-                speed: 0.0,
-                hold: 0.0,
-            });
-            r += 1;
-        }
-        prev_q = wps.last().map(|w| w.q);
-        layers_out.push(LayerPlan {
-            layer: layer.layer,
-            waypoints: wps,
-            cost,
-            min_clearance: min_c,
-            max_speed_ratio: 0.0,
-            wait: 0.0,
-        });
-    }
-    Ok(Station {
-        world_from_base: world_from_base.to_mat4(),
-        layers: layers_out,
-    })
-}
-
-/// Check the joint-interpolated move a → b at ≤ 1° steps; `order` is the layer about to start
-/// (layers before it are printed). Returns a description of the first collision.
-pub(crate) fn transition_collision(
-    ctx: &Context,
-    scene: &Scene,
-    world_from_base: &Iso,
-    a: &Joints,
-    b: &Joints,
-    order: usize,
-) -> Option<String> {
-    let max = (0..6).map(|j| (b[j] - a[j]).abs()).fold(0.0, f64::max);
-    let n = ((max / 1f64.to_radians()).ceil() as usize).max(1);
-    for s in 1..n {
-        let u = s as f64 / n as f64;
-        let q: Joints = std::array::from_fn(|j| a[j] + u * (b[j] - a[j]));
-        let posed = ctx.self_model.pose(&q, &Iso::IDENTITY);
-        let (d, pair) = ctx.self_model.min_self_distance_posed(&posed);
-        if d < ctx.opts.self_clearance {
-            return Some(format!(
-                "self collision {}–{} at {:.0} % of the move",
-                LINK_NAMES[pair.0],
-                LINK_NAMES[pair.1],
-                100.0 * u
-            ));
-        }
-        let env = ctx.env_model.pose(&q, world_from_base);
-        let c = scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
-        if c.distance < 0.0 + 1e-12 && c.object.is_some() {
-            return Some(format!(
-                "{} hits {:?} at {:.0} % of the move",
-                LINK_NAMES[c.link],
-                c.object.unwrap_or_default(),
-                100.0 * u
-            ));
-        }
-    }
-    None
-}
-
-/// Plan the print: resolve the base placement (fixed, or searched with stations), plan every
-/// station, cut the programs, time everything ([`crate::timing`]; waits from the minimum layer
-/// time) and summarise. [`plan_print`] runs [`crate::check::check_plan`] on the result and fails
-/// if it does not pass.
-pub fn plan_print(
-    layers: &[PrintLayer],
-    setup: &RobotSetup,
-    opts: &PlanOptions,
-) -> Result<Plan, RobotError> {
-    plan_print_with_waits(layers, setup, opts, None)
-}
-
-/// [`plan_print`] with per-layer waits (e.g. from the time-dependent schedule) instead of the
-/// minimum layer time.
-pub fn plan_print_with_waits(
-    layers: &[PrintLayer],
-    setup: &RobotSetup,
-    opts: &PlanOptions,
-    waits: Option<&[crate::timing::LayerWait]>,
-) -> Result<Plan, RobotError> {
-    let ctx = validate(layers, setup, opts)?;
-    let stations = match &setup.base {
-        BasePlacement::Fixed { world_from_base } => {
-            let w = Iso::from_mat4(world_from_base)
-                .map_err(|e| RobotError::invalid("base.world_from_base", e))?;
-            vec![
-                plan_station(&ctx, 0, &w, 0..ctx.layers.len(), 0.0)
-                    .map_err(RobotError::Unplannable)?,
-            ]
-        }
-        BasePlacement::Search(search) => crate::base::search_stations(&ctx, search)?,
-    };
-    let mut plan = summarise(&ctx, stations);
-    plan.parts = crate::program::split_parts(&plan)?;
-    crate::timing::apply_timing(&mut plan, waits)?;
-    let report = crate::check::check_plan(&plan);
-    if !report.problems.is_empty() {
-        return Err(RobotError::Verification(report.problems));
-    }
-    plan.certified = Some(CertifiedClearance::of(&report));
-    Ok(plan)
-}
-
-pub(crate) fn summarise(ctx: &Context, stations: Vec<Station>) -> Plan {
-    let mut cost = 0.0;
-    let mut motion = 0.0;
-    let mut min_c = f64::INFINITY;
-    let mut min_self = f64::INFINITY;
-    for s in &stations {
-        let mut prev: Option<Joints> = None;
-        for l in &s.layers {
-            min_c = min_c.min(l.min_clearance);
-            for w in &l.waypoints {
-                if let Some(p) = prev {
-                    for j in 0..6 {
-                        let d: f64 = w.q[j] - p[j];
-                        if !(ctx.coaxial && j == 5) {
-                            cost += d * d;
-                        }
-                        motion += d.abs();
-                    }
-                }
-                let posed = ctx.self_model.pose(&w.q, &Iso::IDENTITY);
-                min_self = min_self.min(ctx.self_model.min_self_distance_posed(&posed).0);
-                prev = Some(w.q);
-            }
-        }
-    }
-    let mut setup = ctx.setup.clone();
-    if let [only] = stations.as_slice() {
-        setup.base = BasePlacement::Fixed {
-            world_from_base: only.world_from_base,
-        };
-    }
-    Plan {
-        flange_from_tcp: ctx.flange_from_tcp.to_mat4(),
-        cost,
-        joint_motion: motion,
-        print_time: 0.0,
-        total_time: 0.0,
-        min_clearance: min_c,
-        min_self_distance: min_self,
-        max_speed_ratio: 0.0,
-        max_acceleration_ratio: 0.0,
-        slowdowns: Vec::new(),
-        parts: Vec::new(),
-        meshes: None,
-        certified: None,
-        mark: PlanMark::default(),
-        setup,
-        options: ctx.opts.clone(),
-        stations,
-    }
+/// Certified lower bounds of the mesh model's clearances along the whole motion (the layer
+/// where each occurs; `index` and `what` are not resolved for a bound).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AlongMotion {
+    /// Arm meshes (links 1–6) to the environment, capped at [`MESH_CUTOFF`].
+    pub environment: ClearanceAt,
+    /// The nozzle capsules to the environment.
+    pub nozzle: ClearanceAt,
+    /// The 13 self pairs on the meshes.
+    pub self_distance: ClearanceAt,
+    /// Configurations measured (waypoints and midpoints added by the splits).
+    pub configurations: usize,
 }

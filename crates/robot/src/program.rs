@@ -11,31 +11,14 @@
 //!
 //! Hand-written: no crate writes URScript.
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::error::RobotError;
 use crate::frames::Iso;
-use crate::kinematics::{Joints, UR10E, joint_delta, within_limits};
+use crate::kinematics::{UR10E, approach_config};
 use crate::plan::Plan;
+pub use crate::plan::ProgramPart;
 use crate::setup::{AnalogDomain, PauseMode};
-
-/// One program file: a contiguous range of layers of one station.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ProgramPart {
-    pub station: usize,
-    /// Layer slots (indices into the station's `layers`), inclusive.
-    pub first: usize,
-    pub last: usize,
-    /// Their layer ids.
-    pub first_layer: i64,
-    pub last_layer: i64,
-    /// Motion targets (move commands) in the file.
-    pub targets: usize,
-    /// The part starts the station: approach from the safe pose and prime the pump.
-    pub starts_station: bool,
-    /// The part ends the station: pump off and retract.
-    pub ends_station: bool,
-}
 
 /// Targets of a part: approach `movej` + `movel` and the other points (starting a station), or
 /// a `movej` to where the previous part stopped and every point (continuing); + the retract.
@@ -186,41 +169,6 @@ fn num(x: f64) -> String {
     } else {
         s
     }
-}
-
-/// The safe approach configuration: the first target backed off `dist` along the tool axis,
-/// the IK solution nearest `q` (same branch), unwrapped next to `q`.
-pub(crate) fn approach_config(
-    q: &Joints,
-    tool: &Iso,
-    dist: f64,
-    limits: &[[f64; 2]; 6],
-) -> Result<Joints, RobotError> {
-    let tcp = UR10E.fk(q).mul(tool);
-    let back = tcp.mul(&Iso::translation(0.0, 0.0, -dist));
-    let flange = back.mul(&tool.inverse());
-    let sols = UR10E.ik(&flange);
-    let mut best: Option<(f64, Joints)> = None;
-    for s in sols.as_slice() {
-        let d = joint_delta(q, s);
-        let cand: Joints = std::array::from_fn(|j| q[j] + d[j]);
-        if !within_limits(&cand, limits) {
-            continue;
-        }
-        let c: f64 = d.iter().map(|v| v * v).sum();
-        if best.is_none_or(|b| c < b.0) {
-            best = Some((c, cand));
-        }
-    }
-    best.map(|b| b.1).ok_or_else(|| {
-        RobotError::invalid(
-            "program.approach_distance",
-            format!(
-                "no joint configuration reaches the approach pose {dist} m behind the target {:?}",
-                tcp.t.to_array()
-            ),
-        )
-    })
 }
 
 /// One program file.

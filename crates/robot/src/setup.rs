@@ -101,7 +101,7 @@ pub struct BaseSearch {
     /// where a base a few millimetres off can no longer print its last layers. `None`: the
     /// nominal pose only.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub margin: Option<crate::tolerance::BaseTolerance>,
+    pub margin: Option<BaseTolerance>,
 }
 
 impl Default for BaseSearch {
@@ -331,7 +331,7 @@ impl JointLimitOptions {
     }
 
     /// Check the position limits: finite, min < max, within ±360° (the controller's range);
-    /// [`RobotError::JointPositionLimit`] names the first bad joint.
+    /// [`crate::error::RobotError::JointPositionLimit`] names the first bad joint.
     pub fn validate_positions(&self) -> Result<(), crate::error::RobotError> {
         for (j, &[min, max]) in self.position_deg.iter().enumerate() {
             let ok =
@@ -600,4 +600,40 @@ impl Default for ProgramOptions {
             payload_cog: [0.0, 0.0, 0.1],
         }
     }
+}
+
+/// The base-pose errors a plan must tolerate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BaseTolerance {
+    /// Largest position error of the base in x and y, m (default 0.010).
+    pub position: f64,
+    /// Largest yaw error of the base, degrees (default 1.0).
+    pub yaw_deg: f64,
+    /// Check every n-th waypoint of a layer (and always its first and last); 1 = every waypoint.
+    pub stride: usize,
+}
+
+impl Default for BaseTolerance {
+    fn default() -> Self {
+        BaseTolerance {
+            position: 0.010,
+            yaw_deg: 1.0,
+            stride: 1,
+        }
+    }
+}
+
+/// The 9 sampled base errors `(dx, dy, dyaw)`: the box's corners and its centre.
+pub fn sampled_errors(tol: &BaseTolerance) -> Vec<(f64, f64, f64)> {
+    let (p, a) = (tol.position, tol.yaw_deg.to_radians());
+    let mut out = vec![(0.0, 0.0, 0.0)];
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sa in [-1.0, 1.0] {
+                out.push((sx * p, sy * p, sa * a));
+            }
+        }
+    }
+    out
 }

@@ -29,22 +29,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::RobotError;
 use crate::plan::Plan;
+pub use crate::plan::Slowdown;
 
 /// A move slower than 98 % of the design speed is reported.
 pub const SLOWDOWN_REPORT: f64 = 0.98;
-
-/// A range of consecutive print moves that is slower than the design speed.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Slowdown {
-    pub station: usize,
-    /// Layer and point index of the first and last waypoint reached by a slow move.
-    pub from: (i64, usize),
-    pub to: (i64, usize),
-    /// Lowest tool speed / design speed in the range.
-    pub min_speed_ratio: f64,
-    /// Why: "joint speed (joint j)" or "joint acceleration".
-    pub reason: String,
-}
 
 /// When one layer is printed, on the plan's clock.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -16,41 +16,21 @@
 //! rotations, by the same argument).
 //!
 //! Per corner and waypoint the valid IK configurations are those the planner itself accepts
-//! ([`crate::plan`]: limits, singularity margins, self-collision, clearance ≥ the plan's margin,
+//! ([`crate::planner`]: limits, singularity margins, self-collision, clearance ≥ the plan's margin,
 //! printed layers as obstacles); the one nearest the planned joints on the same elbow/wrist branch
 //! is taken, and consecutive ones must stay within the plan's compatibility ε (the trajectory is
 //! re-solvable without a reconfiguration). Hand-written: it is a property of this planner's
 //! acceptance rules, which no crate knows.
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::collision::{Obstacle, Scene};
 use crate::frames::Iso;
-use crate::kinematics::joint_delta;
-use crate::plan::{Plan, validate};
-
-/// The base-pose errors a plan must tolerate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct BaseTolerance {
-    /// Largest position error of the base in x and y, m (default 0.010).
-    pub position: f64,
-    /// Largest yaw error of the base, degrees (default 1.0).
-    pub yaw_deg: f64,
-    /// Check every n-th waypoint of a layer (and always its first and last); 1 = every waypoint.
-    pub stride: usize,
-}
-
-impl Default for BaseTolerance {
-    fn default() -> Self {
-        BaseTolerance {
-            position: 0.010,
-            yaw_deg: 1.0,
-            stride: 1,
-        }
-    }
-}
+use crate::kinematics::{Joints, joint_delta};
+use crate::plan::{Plan, plan_layers};
+use crate::planner::{Rejections, Vertex, validate};
+pub use crate::setup::{BaseTolerance, sampled_errors};
 
 /// The result of [`check_base_tolerance`]; the plan tolerates the errors when `problems` is empty.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -81,20 +61,6 @@ impl ToleranceReport {
     }
 }
 
-/// The 9 sampled base errors `(dx, dy, dyaw)`: the box's corners and its centre.
-pub fn sampled_errors(tol: &BaseTolerance) -> Vec<(f64, f64, f64)> {
-    let (p, a) = (tol.position, tol.yaw_deg.to_radians());
-    let mut out = vec![(0.0, 0.0, 0.0)];
-    for sx in [-1.0, 1.0] {
-        for sy in [-1.0, 1.0] {
-            for sa in [-1.0, 1.0] {
-                out.push((sx * p, sy * p, sa * a));
-            }
-        }
-    }
-    out
-}
-
 /// Check every station of `plan` under base-pose errors up to `tol` (see the module docs).
 pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport {
     let mut rep = ToleranceReport {
@@ -111,7 +77,7 @@ pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport
         ));
         return rep;
     }
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let ctx = match validate(&layers, &plan.setup, &plan.options) {
         Ok(c) => c,
         Err(e) => {
@@ -166,12 +132,78 @@ struct PoseResult {
     problems: Vec<String>,
 }
 
+/// Re-solving one layer's checked waypoints from a perturbed base (module docs), for the
+/// stations ([`check_base_tolerance`]) and the moving base
+/// ([`crate::moving::check_moving_tolerance`]) alike: of the valid configurations the planner
+/// accepts at a waypoint, the one on the planned elbow/wrist branch (signs of sin q3, sin q5)
+/// nearest the planned joints is taken, and consecutive ones must stay within
+/// `Σ Δq² ≤ ε·stride²`.
+pub(crate) struct Resolver {
+    prev: Option<Joints>,
+    allowed: f64,
+}
+
+impl Resolver {
+    /// For a layer of `n` waypoints checked every `stride`-th, with the plan's compatibility
+    /// `epsilon`.
+    pub(crate) fn new(epsilon: f64, stride: usize, n: usize) -> Self {
+        // Only consecutive checked points are compared: with a stride the allowed motion grows
+        // with the number of steps skipped.
+        Resolver {
+            prev: None,
+            allowed: epsilon * (stride.min(n) as f64).powi(2),
+        }
+    }
+
+    /// The next checked waypoint (planned joints `planned`) among its valid configurations
+    /// `verts` (`rej`: why the others were refused): the chosen one's clearance lowers
+    /// `min_clearance`; what fails goes to `problems`, after `point` (where it is).
+    pub(crate) fn next(
+        &mut self,
+        planned: &Joints,
+        verts: &[Vertex],
+        rej: &Rejections,
+        point: &str,
+        min_clearance: &mut f64,
+        problems: &mut Vec<String>,
+    ) {
+        let branch = |q: &Joints| (q[2].sin() > 0.0, q[4].sin() > 0.0);
+        let best = verts
+            .iter()
+            .filter(|v| branch(&v.q) == branch(planned))
+            .map(|v| {
+                let d2: f64 = joint_delta(planned, &v.q).iter().map(|d| d * d).sum();
+                (d2, v)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let Some((_, v)) = best else {
+            let (_, detail) = rej.failure();
+            problems.push(format!(
+                "{point} has no valid configuration on the planned branch ({detail})"
+            ));
+            self.prev = None;
+            return;
+        };
+        *min_clearance = min_clearance.min(v.clearance);
+        if let Some(p) = self.prev {
+            let step: f64 = joint_delta(&p, &v.q).iter().map(|d| d * d).sum();
+            if step > self.allowed {
+                problems.push(format!(
+                    "{point}: the re-solved joints jump by Σ Δq² = {step:.4} rad² (> ε·stride² = {:.4})",
+                    self.allowed
+                ));
+            }
+        }
+        self.prev = Some(v.q);
+    }
+}
+
 /// Station `si` of `plan` re-solved from its base moved by `(dx, dy, dyaw)` (see the module
 /// docs); with `first_problem` it stops at the first problem (the margin search only needs
 /// pass or fail).
 fn check_pose(
     plan: &Plan,
-    ctx: &crate::plan::Context,
+    ctx: &crate::planner::Context,
     first_order: &[usize],
     si: usize,
     (dx, dy, da): (f64, f64, f64),
@@ -247,7 +279,7 @@ fn check_pose(
             continue;
         };
         let n = l.waypoints.len();
-        let mut prev: Option<[f64; 6]> = None;
+        let mut resolver = Resolver::new(eps, stride, n);
         for (k, w) in l.waypoints.iter().enumerate() {
             if k % stride != 0 && k + 1 != n {
                 continue;
@@ -258,41 +290,15 @@ fn check_pose(
             r.checked += 1;
             let frame = ctx.target_frame(layer, k);
             let (verts, rej) = ctx.vertices(&scene, &inv, &world_from_base, &frame, order);
-            let branch = |q: &[f64; 6]| (q[2].sin() > 0.0, q[4].sin() > 0.0);
-            let best = verts
-                .iter()
-                .filter(|v| branch(&v.q) == branch(&w.q))
-                .map(|v| {
-                    let d2: f64 = joint_delta(&w.q, &v.q).iter().map(|d| d * d).sum();
-                    (d2, v)
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0));
-            match best {
-                None => {
-                    let (_, detail) = rej.failure();
-                    r.problems.push(format!(
-                        "{at}: layer {} point {} has no valid configuration on the planned branch ({detail})",
-                        l.layer, w.index
-                    ));
-                    prev = None;
-                }
-                Some((_, v)) => {
-                    r.min_clearance = r.min_clearance.min(v.clearance);
-                    if let Some(p) = prev {
-                        let step: f64 = joint_delta(&p, &v.q).iter().map(|d| d * d).sum();
-                        // Only consecutive checked points are compared: with a stride the
-                        // allowed motion grows with the number of steps skipped.
-                        let allowed = eps * (stride.min(n) as f64).powi(2);
-                        if step > allowed {
-                            r.problems.push(format!(
-                                "{at}: layer {} point {}: the re-solved joints jump by Σ Δq² = {step:.4} rad² (> ε = {allowed:.4})",
-                                l.layer, w.index
-                            ));
-                        }
-                    }
-                    prev = Some(v.q);
-                }
-            }
+            let point = format!("{at}: layer {} point {}", l.layer, w.index);
+            resolver.next(
+                &w.q,
+                &verts,
+                &rej,
+                &point,
+                &mut r.min_clearance,
+                &mut r.problems,
+            );
         }
     }
     r
@@ -330,10 +336,10 @@ const MARGIN_RESOLUTION: f64 = 0.125;
 /// A station that fails at `tol` itself gets the largest passing fraction below 1. The pass/fail
 /// of a trial is monotone in the scale only to first order (a larger box contains the smaller
 /// one's corners' effects): the result is a bisection estimate to within
-/// [`MARGIN_RESOLUTION`] of the box, not a certified bound; the certified statement is the
+/// `MARGIN_RESOLUTION` of the box, not a certified bound; the certified statement is the
 /// pass/fail of [`check_base_tolerance`] at the stated tolerance.
 pub fn station_margins(plan: &Plan, tol: &BaseTolerance) -> Vec<StationMargin> {
-    let layers = crate::check::plan_layers(plan);
+    let layers = plan_layers(plan);
     let Ok(ctx) = validate(&layers, &plan.setup, &plan.options) else {
         return Vec::new();
     };

@@ -1,7 +1,9 @@
 //! Issue 15: `kappe design` runs a ceiling file (three bays at a small size) end to end: every
 //! bay designed, analysed and planned, a room summary, one page for the room, every bay's report.
 
-use std::process::Command;
+use std::process::Output;
+
+use crate::common::{kappe, text};
 
 /// The three-bay room shared with the other ceiling tests.
 const SMALL: &str = include_str!(concat!(
@@ -9,29 +11,22 @@ const SMALL: &str = include_str!(concat!(
     "/../kappe/tests/data/small_room.toml"
 ));
 
+/// `kappe design room.toml --out room --quiet` and `extra` on the ceiling file `room`, in a fresh
+/// temporary directory (kept alive by the returned handle).
+fn design_room(room: &str, extra: &[&str]) -> (tempfile::TempDir, Output) {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("room.toml"), room).unwrap();
+    let mut args = vec!["design", "room.toml", "--out", "room", "--quiet"];
+    args.extend_from_slice(extra);
+    let o = kappe(tmp.path(), &args);
+    (tmp, o)
+}
+
 #[test]
 fn design_runs_a_three_bay_ceiling() {
-    let tmp = tempfile::tempdir().unwrap();
-    std::fs::write(tmp.path().join("room.toml"), SMALL).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_kappe"))
-        .current_dir(tmp.path())
-        .args([
-            "design",
-            "room.toml",
-            "--out",
-            "room",
-            "--quiet",
-            "--states",
-            "every:4",
-        ])
-        .output()
-        .unwrap();
+    let (tmp, o) = design_room(SMALL, &["--states", "every:4"]);
     let code = o.status.code().unwrap_or(-1);
-    assert!(
-        code == 0 || code == 1,
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert!(code == 0 || code == 1, "{}", text(&o.stderr));
     let out = tmp.path().join("room");
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("ceiling.json")).unwrap()).unwrap();
@@ -67,30 +62,11 @@ fn design_runs_a_three_bay_ceiling() {
 /// creeps toward −y (its front advances that way) while the first half's creeps toward +y.
 #[test]
 fn moving_base_ceiling_plans_each_half_moving() {
-    let tmp = tempfile::tempdir().unwrap();
     // One default-size bay (0.8 m span, as the moving default cap) between walls 1 m apart.
     let room = "name = \"moving room\"\n[ceiling]\nlength = 1.0\nends = \"both_walls\"\n\
                 rise_ratio = 0.25\n[[bay]]\nspan = 0.8\n[robot.base]\nmode = \"moving\"\n";
-    std::fs::write(tmp.path().join("room.toml"), room).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_kappe"))
-        .current_dir(tmp.path())
-        .args([
-            "design",
-            "room.toml",
-            "--out",
-            "room",
-            "--quiet",
-            "--no-buckling",
-            "--allow-fail",
-        ])
-        .output()
-        .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let (tmp, o) = design_room(room, &["--no-buckling", "--allow-fail"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let bay = tmp.path().join("room/bay_1");
     let base_y = |p: &std::path::Path| -> Vec<f64> {
         let text = std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
@@ -121,16 +97,11 @@ fn moving_base_ceiling_plans_each_half_moving() {
             .unwrap_or_else(|e| panic!("{half}program_part01.script: {e}"));
         assert!(prog.contains("track_conveyor_linear"), "{half}");
         // The tracking form passes `kappe robot lint` (issue 27 verification).
-        let lint = Command::new(env!("CARGO_BIN_EXE_kappe"))
-            .current_dir(&bay)
-            .args(["robot", "lint", &format!("{half}program_part01.script")])
-            .output()
-            .unwrap();
-        assert!(
-            lint.status.success(),
-            "{}",
-            String::from_utf8_lossy(&lint.stdout)
+        let lint = kappe(
+            &bay,
+            &["robot", "lint", &format!("{half}program_part01.script")],
         );
+        assert!(lint.status.success(), "{}", text(&lint.stdout));
     }
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(tmp.path().join("room/ceiling.json")).unwrap())

@@ -578,7 +578,7 @@ fn collision_meshes_are_checked_with_the_base_where_it_is() {
     for l in &mut still.travel {
         l.iter_mut().for_each(|s| *s = 0.0);
     }
-    let moving = meshes::verify_meshes_moving(&still, 5).unwrap();
+    let moving = moving::verify_meshes_moving(&still, 5).unwrap();
     let station = meshes::verify_meshes(&still.plan, 5).unwrap();
     for (a, b, what) in [
         (
@@ -620,7 +620,7 @@ fn collision_meshes_are_checked_with_the_base_where_it_is() {
         half_extents: [0.01, 0.01, 0.01],
         yaw: 0.0,
     });
-    let rep = meshes::verify_meshes_moving(&hit, 5).unwrap();
+    let rep = moving::verify_meshes_moving(&hit, 5).unwrap();
     // The arm passes there at neighbouring layers too, and the list stops at 20 entries: it is
     // enough that the probe is found touching.
     assert!(
