@@ -3,7 +3,8 @@
 //!
 //! * `default`: the failure layer with the default imperfection rule and the clamped base,
 //!   next to the five observed failures (25, 27, 30, 31, 31).
-//! * `matrix`: w0 = rule, 0, 1, 2, 5 mm, each with the clamped and the pinned base.
+//! * `matrix`: w0 = rule, 0, 1, 2, 5 mm, each with the clamped and the pinned base, and the
+//!   as-printed start (`asprinted` alone: only those, docs/collapse.md §8).
 //! * `speed`: per layer count 10, 20, 30, 40: one LBA solve against one collapse path (best of
 //!   three), and `kappe buildability` of the 60-layer cylinder with the collapse check at every
 //!   layer (wall-clock, CPU).
@@ -86,6 +87,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "  rule, clamped, no material check along the path: {}",
             failure(&r)?
         );
+    }
+    if what == "matrix" || what == "asprinted" {
+        // docs/collapse.md §8: the path from the as-printed shape (rule w0 on top), next to
+        // the design start.
+        for base in ["clamped", "pinned"] {
+            let r = spec("", &format!("base = \"{base}\"\nstart = \"as_printed\""))?;
+            println!("  rule, {base}, as-printed start: {}", failure(&r)?);
+        }
+        let r = spec("", "imperfection = 0.0\nstart = \"as_printed\"")?;
+        println!("  w0 = 0, clamped, as-printed start: {}", failure(&r)?);
     }
     if what == "diag" {
         diag()?;
