@@ -720,8 +720,7 @@ fn panel_bifurcation_matches_linear_buckling() {
 
 /// The collapse check's fast options (modified Newton, secant predictor; docs/nonlinear.md
 /// "Speed") trace the same path as full Newton with the tangent predictor: the limit point
-/// of the imperfect Roorda frame (both signs: the asymmetric bifurcation's two branches) and
-/// of the hinged roof (snap-through) within 2e-3 relative. That is twice the path's own
+/// of the imperfect Roorda frame within 2e-3 relative. That is twice the path's own
 /// location tolerance (a step crossing a change of the tangent's inertia is shortened to
 /// 1e-3 of λ, `LOCATE`): the two runs bracket the same point from different steps. What they
 /// save is measured by the benchmarks (docs/nonlinear.md "Speed"), not asserted here.
@@ -742,32 +741,18 @@ fn fast_path_options_find_the_same_limit_points() {
     )
     .unwrap();
     let lam_lba = lba.factors[0];
-    let mut cases: Vec<(String, ShellModel, PathOptions)> = Vec::new();
-    for sign in [1.0, -1.0] {
-        let mi = with_imperfection(&m, &lba.modes[0], sign * 1e-3).unwrap();
-        cases.push((
-            format!("Roorda frame, w0 = {}", sign * 1e-3),
-            mi,
-            PathOptions {
-                initial_increment: 0.2 * lam_lba,
-                lambda_max: 1.5 * lam_lba,
-                max_steps: 80,
-                ..Default::default()
-            },
-        ));
-    }
-    let (roof, _) = hinged_roof(6.35, 12);
-    cases.push((
-        "hinged roof t = 6.35".into(),
-        roof,
+    // The sign whose path has a limit point (the other rises on the stable branch of the
+    // asymmetric bifurcation to λ_max).
+    let cases: Vec<(String, ShellModel, PathOptions)> = vec![(
+        "Roorda frame, w0 = 0.001".into(),
+        with_imperfection(&m, &lba.modes[0], 1e-3).unwrap(),
         PathOptions {
-            initial_increment: 0.05,
-            lambda_max: 1.0,
-            max_arc_length: Some(1.0),
-            max_steps: 400,
+            initial_increment: 0.2 * lam_lba,
+            lambda_max: 1.5 * lam_lba,
+            max_steps: 80,
             ..Default::default()
         },
-    ));
+    )];
     for (name, model, opt) in cases {
         let slow = run(&model, &opt);
         let quick = run(&model, &fast(opt.clone()));
