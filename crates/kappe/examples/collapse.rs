@@ -3,7 +3,8 @@
 //!
 //! * `default`: the failure layer with the default imperfection rule and the clamped base,
 //!   next to the five observed failures (25, 27, 30, 31, 31).
-//! * `matrix`: w0 = rule, 0, 1, 2, 5 mm, each with the clamped and the pinned base.
+//! * `matrix`: w0 = rule, 0, 1, 2, 5 mm, each with the clamped and the pinned base, and the
+//!   as-printed start (`asprinted` alone: only those, docs/collapse.md §8).
 //! * `speed`: per layer count 10, 20, 30, 40: one LBA solve against one collapse path (best of
 //!   three), and `kappe buildability` of the 60-layer cylinder with the collapse check at every
 //!   layer (wall-clock, CPU).
@@ -87,6 +88,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             failure(&r)?
         );
     }
+    if what == "matrix" || what == "asprinted" {
+        // docs/collapse.md §8: the path from the as-printed shape (rule w0 on top), next to
+        // the design start.
+        for base in ["clamped", "pinned"] {
+            let r = spec("", &format!("base = \"{base}\"\nstart = \"as_printed\""))?;
+            println!("  rule, {base}, as-printed start: {}", failure(&r)?);
+        }
+        let r = spec("", "imperfection = 0.0\nstart = \"as_printed\"")?;
+        println!("  w0 = 0, clamped, as-printed start: {}", failure(&r)?);
+    }
     if what == "diag" {
         diag()?;
     }
@@ -102,29 +113,46 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if what == "speed" {
         let r = spec("", "")?;
         println!(
-            "  {:>4} {:>8} {:>10} {:>10} {:>8} {:>6}",
-            "n", "DOFs", "t_LBA [s]", "t_path [s]", "ratio", "steps"
+            "  {:>4} {:>8} {:>10} {:>10} {:>8} {:>10} {:>10} {:>8} {:>6} {:>5} {:>9}",
+            "n",
+            "DOFs",
+            "t_LBA [s]",
+            "t_path [s]",
+            "ratio",
+            "CPU LBA",
+            "CPU path",
+            "CPU ×",
+            "steps",
+            "LDLt",
+            "collapse"
         );
+        let cpu = || cpu_seconds().unwrap_or(f64::NAN);
         for n in [10, 20, 30, 40] {
-            let mut t_lba = f64::INFINITY;
-            let mut t_all = f64::INFINITY;
-            let mut steps = 0;
+            let (mut t_lba, mut t_all) = (f64::INFINITY, f64::INFINITY);
+            let (mut c_lba, mut c_all) = (f64::INFINITY, f64::INFINITY);
+            let mut last = None;
             for _ in 0..3 {
-                let t0 = Instant::now();
+                let (t0, c0) = (Instant::now(), cpu());
                 let mut plain = r.clone();
                 plain.spec.analysis = None;
                 let _ = kappe::commands::buildability::check_layers(&plain, n)?;
                 t_lba = t_lba.min(t0.elapsed().as_secs_f64());
-                let t1 = Instant::now();
+                c_lba = c_lba.min(cpu() - c0);
+                let (t1, c1) = (Instant::now(), cpu());
                 let s = kappe::commands::buildability::check_layers(&r, n)?;
                 t_all = t_all.min(t1.elapsed().as_secs_f64());
-                steps = s.collapse.map_or(0, |c| c.steps);
+                c_all = c_all.min(cpu() - c1);
+                last = s.collapse;
             }
             let dofs = 6 * r.segments * n;
+            let (steps, ldlt, factor) =
+                last.map_or((0, 0, f64::NAN), |c| (c.steps, c.factorizations, c.factor));
             println!(
-                "  {n:>4} {dofs:>8} {t_lba:>10.3} {:>10.3} {:>8.1} {steps:>6}",
+                "  {n:>4} {dofs:>8} {t_lba:>10.3} {:>10.3} {:>8.1} {c_lba:>10.2} {:>10.2} {:>8.1} {steps:>6} {ldlt:>5} {factor:>9.5}",
                 t_all - t_lba,
-                (t_all - t_lba) / t_lba
+                (t_all - t_lba) / t_lba,
+                c_all - c_lba,
+                (c_all - c_lba) / c_lba
             );
         }
         let mut every = r.clone();

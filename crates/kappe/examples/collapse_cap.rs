@@ -1,15 +1,33 @@
-//! The collapse check of the default cap (docs/collapse.md §5): per state run, the collapse
-//! factor next to its BLF, and the analysis time with and without the check:
-//! `cargo run --release -p kappe --example collapse_cap`.
+//! The collapse check of the default cap (docs/collapse.md §5–6): per state run, the collapse
+//! factor next to its BLF, the time of its path against its own linear buckling solve (wall and
+//! CPU), and the analysis time with and without the check:
+//! `cargo run --release -p kappe --example collapse_cap [-- STATES [SIGNS [as_printed]]]`
+//! (STATES: how many of the least-BLF states, default 3; SIGNS: force 1 or 2 imperfection
+//! signs, 0 = the rule; `as_printed`: also each state's path from the as-printed shape,
+//! docs/collapse.md §8). STATES = 0 skips the table; the analysis with the check runs last
+//! unless `NO_FULL` is the fourth argument.
 
 use std::time::Instant;
 
+#[path = "common/measure.rs"]
+mod measure;
+use measure::{cpu_seconds, load_average};
+
 use kappe::analysis::analyze;
-use kappe::analysis::cap_state_collapse;
+use kappe::analysis::{cap_state_collapse, cap_state_lba};
 use kappe::input::AnalysisOptions;
 use kappe::input::NonlinearSpec;
 
+fn cpu() -> f64 {
+    cpu_seconds().unwrap_or(f64::NAN)
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let arg = |i: usize| {
+        std::env::args()
+            .nth(i)
+            .and_then(|a| a.parse::<usize>().ok())
+    };
     let design = kappe::Design::from_toml_str(kappe::input::EXAMPLE_TOML)?;
     let cap = kappe::design_cap(&design, kappe::Context::default())?;
     let off = AnalysisOptions {
@@ -19,58 +37,109 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }),
         ..Default::default()
     };
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu());
     let a = analyze(&cap, &off, kappe::analysis::Request::default())?;
-    let t_off = t0.elapsed().as_secs_f64();
+    let (t_off, c_off) = (t0.elapsed().as_secs_f64(), cpu() - c0);
     let mut by_bound: Vec<(usize, f64)> = a
         .states
         .iter()
         .filter_map(|s| s.blf.map(|b| (s.index, b)))
         .collect();
     by_bound.sort_by(|x, y| x.1.total_cmp(&y.1));
-    println!("analysis without the collapse check: {t_off:.2} s");
-    let spec = NonlinearSpec::default();
     println!(
-        "  {:>5} {:>8} {:>9} {:>14} {:>6} {:>7} {:>8}",
-        "state", "BLF", "collapse", "mode", "steps", "asm", "t [s]"
+        "analysis without the collapse check: {t_off:.2} s wall, {c_off:.2} s CPU (load {})",
+        load_average()
     );
-    for &(q, b) in by_bound.iter().take(
-        std::env::args()
-            .nth(1)
-            .and_then(|a| a.parse().ok())
-            .unwrap_or(3),
-    ) {
-        let t = Instant::now();
-        let c = cap_state_collapse(&cap, &AnalysisOptions::default(), &spec, None, q)?;
+    let spec = NonlinearSpec {
+        signs: arg(2).filter(|s| *s > 0),
+        ..Default::default()
+    };
+    let words: Vec<String> = std::env::args().collect();
+    let as_printed = words.iter().any(|w| w == "as_printed");
+    println!(
+        "  {:>5} {:>8} {:>9} {:>12} {:>5} {:>5} {:>5} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7}",
+        "state",
+        "BLF",
+        "collapse",
+        "mode",
+        "steps",
+        "asm",
+        "LDLt",
+        "LBA wall",
+        "LBA CPU",
+        "path wall",
+        "path CPU",
+        "wall ×",
+        "CPU ×"
+    );
+    let options = AnalysisOptions::default();
+    for &(q, b) in by_bound.iter().take(arg(1).unwrap_or(3)) {
+        // The state's linear buckling solve alone (the collapse check's first half), best of
+        // two so a cold cache does not count against the LBA.
+        let (mut tl, mut cl) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..2 {
+            let (t, c) = (Instant::now(), cpu());
+            let _ = cap_state_lba(&cap, &options, None, q)?;
+            tl = tl.min(t.elapsed().as_secs_f64());
+            cl = cl.min(cpu() - c);
+        }
+        let (t, c0) = (Instant::now(), cpu());
+        let c = cap_state_collapse(&cap, &options, &spec, None, q)?;
+        let (tp, cp) = (t.elapsed().as_secs_f64(), cpu() - c0);
         if let Some(c) = c {
             println!(
-                "  {q:>5} {b:>8.3} {:>9.3} {:>14} {:>6} {:>7} {:>8.2}",
+                "  {q:>5} {b:>8.4} {:>9.4} {:>12} {:>5} {:>5} {:>5} {tl:>9.2} {cl:>9.2} {tp:>9.2} {cp:>9.2} {:>7.1} {:>7.1}",
                 c.factor,
                 c.mode.name(),
                 c.steps,
                 c.assemblies,
-                t.elapsed().as_secs_f64()
+                c.factorizations,
+                tp / tl,
+                cp / cl
             );
         }
+        if as_printed {
+            let ap = NonlinearSpec {
+                start: kappe::input::PathStart::AsPrinted,
+                ..spec
+            };
+            let (t, c0) = (Instant::now(), cpu());
+            if let Some(c) = cap_state_collapse(&cap, &options, &ap, None, q)? {
+                println!(
+                    "  {q:>5} as-printed start: collapse {:.4} {} ({} steps, {} LDLt; {:.2} s wall, {:.2} s CPU)",
+                    c.factor,
+                    c.mode.name(),
+                    c.steps,
+                    c.factorizations,
+                    t.elapsed().as_secs_f64(),
+                    cpu() - c0
+                );
+            }
+        }
     }
-    let t1 = Instant::now();
+    if words.iter().any(|w| w == "NO_FULL") {
+        return Ok(());
+    }
+    let (t1, c1) = (Instant::now(), cpu());
     let on = AnalysisOptions {
-        nonlinear: Some(NonlinearSpec::default()),
+        nonlinear: Some(spec),
         ..Default::default()
     };
     let a2 = analyze(&cap, &on, kappe::analysis::Request::default())?;
-    let t_on = t1.elapsed().as_secs_f64();
+    let (t_on, c_on) = (t1.elapsed().as_secs_f64(), cpu() - c1);
     let run: Vec<String> = a2
         .states
         .iter()
         .filter_map(|s| {
             s.collapse_factor
-                .map(|c| format!("{}: {c:.3} (BLF {:.3})", s.index, s.blf.unwrap_or(f64::NAN)))
+                .map(|c| format!("{}: {c:.4} (BLF {:.4})", s.index, s.blf.unwrap_or(f64::NAN)))
         })
         .collect();
     println!(
-        "analysis with the collapse check: {t_on:.2} s ({:.2}× without); states run: {}",
+        "analysis with the collapse check: {t_on:.2} s wall ({:.2}× without), {c_on:.2} s CPU ({:.2}× without; load {}); states run: {}",
         t_on / t_off,
+        c_on / c_off,
+        load_average(),
         run.join(", ")
     );
     Ok(())

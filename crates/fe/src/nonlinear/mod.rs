@@ -40,8 +40,11 @@
 pub mod corotational;
 mod linearised;
 mod path;
+mod symmetry;
 
 pub use linearised::{Linearisation, LinearisedCritical, linearised_critical_factor};
+
+pub use symmetry::{Mirror, mirror_symmetries};
 
 pub use path::{
     LimitKind, LimitPoint, Path, PathControl, PathOptions, PathStats, PathStep, StopReason,

@@ -63,6 +63,13 @@ pub struct PathOptions {
     /// default because it is less proven (with it, the load-controlled cantilever of the
     /// tests takes more than 200 steps).
     pub modified_newton: bool,
+    /// Arc length: predict each step after the first along the previous converged step's
+    /// increment (Δu, Δλ) scaled to the new arc length (the secant predictor) instead of the
+    /// tangent's solution under the reference load (default false). The secant follows the
+    /// path's curvature of the last step, so the corrector starts closer to the path and
+    /// passes a load maximum without the tangent's sign test; it also saves the predictor's
+    /// solve.
+    pub secant_predictor: bool,
     /// Length ℓ weighting rotations in the arc-length norm (rotation·ℓ ≈ a translation);
     /// `None` (default): the mean edge length of the mesh.
     pub rotation_length: Option<f64>,
@@ -88,6 +95,7 @@ impl Default for PathOptions {
             tolerance: 1e-6,
             stop_at_limit: true,
             modified_newton: false,
+            secant_predictor: false,
             rotation_length: None,
             local_geometric: true,
         }
@@ -468,17 +476,45 @@ impl<'a, 'm> Solver<'a, 'm> {
         control: StepControl<'_>,
     ) -> Result<Option<Converged<'a>>, FeError> {
         let p = self.p;
-        let ut = solve_t(factor0, k0, p, &p.q)?.0;
         let mut st = from.clone();
         let mut lambda = lambda0;
         let mut du_step: Vec<f64>;
         let mut arc_eff = 0.0;
+        let secant = match control {
+            StepControl::Arc {
+                prev: Some(prev),
+                prev_dlambda: Some(pdl),
+                ..
+            } if self.opt.secant_predictor => {
+                let np = dot_w(&p.weight, prev, prev).sqrt();
+                (np > 0.0 && np.is_finite()).then_some((prev, pdl, np))
+            }
+            _ => None,
+        };
         match control {
             StepControl::Load(dl) => {
+                let ut = solve_t(factor0, k0, p, &p.q)?.0;
                 du_step = ut.iter().map(|v| v * dl).collect();
                 lambda += dl;
             }
-            StepControl::Arc { dl, prev, dlam_max } => {
+            StepControl::Arc { dl, dlam_max, .. } if secant.is_some() => {
+                let Some((prev, pdl, np)) = secant else {
+                    return Ok(None);
+                };
+                // The previous increment scaled to the new arc length, its Δλ capped as the
+                // tangent predictor's is.
+                let mut s = dl / np;
+                if (pdl * s).abs() > dlam_max {
+                    s = dlam_max / pdl.abs();
+                }
+                arc_eff = s * np;
+                du_step = prev.iter().map(|v| v * s).collect();
+                lambda += pdl * s;
+            }
+            StepControl::Arc {
+                dl, prev, dlam_max, ..
+            } => {
+                let ut = solve_t(factor0, k0, p, &p.q)?.0;
                 let nut = dot_w(&p.weight, &ut, &ut).sqrt();
                 // Cap the predicted load increment (stiff pre-buckling states).
                 let dl = dl.min(dlam_max * nut);
@@ -626,6 +662,8 @@ enum StepControl<'v> {
     Arc {
         dl: f64,
         prev: Option<&'v [f64]>,
+        /// Δλ of the previous converged step (the secant predictor's).
+        prev_dlambda: Option<f64>,
         dlam_max: f64,
     },
 }
@@ -696,6 +734,7 @@ pub fn nonlinear_path(
     .max(step0);
     let mut size = step0;
     let mut prev: Option<Vec<f64>> = None;
+    let mut prev_dlambda: Option<f64> = None;
     let mut steps: Vec<PathStep> = Vec::new();
     let mut limit: Option<LimitPoint> = None;
     let mut s_cum = vec![0.0];
@@ -713,6 +752,7 @@ pub fn nonlinear_path(
                 StepControl::Arc {
                     dl: size,
                     prev: prev.as_deref(),
+                    prev_dlambda,
                     dlam_max: options.max_step_ratio * options.initial_increment,
                 }
             } else if to_max {
@@ -812,12 +852,14 @@ pub fn nonlinear_path(
         // Next step size.
         let ratio = (options.target_iterations as f64 / c.cost.max(1.0)).sqrt();
         size = (size * ratio.clamp(0.5, 2.0)).clamp(smin, smax);
+        let lambda_before = lambda;
         lambda = c.lambda;
         state = c.state;
         factor = c.factor;
         kvals = c.kvals;
         neg = new_neg;
         prev = Some(c.du);
+        prev_dlambda = Some(c.lambda - lambda_before);
         if let ControlFlow::Break(reason) = flow {
             stop = reason;
             break;

@@ -717,3 +717,119 @@ fn panel_bifurcation_matches_linear_buckling() {
     assert!(gaps[0] > 3.0 * gaps[1], "{gaps:?}");
     assert!(gaps[1] < 0.01, "{gaps:?}");
 }
+
+/// The collapse check's fast options (modified Newton, secant predictor; docs/nonlinear.md
+/// "Speed") trace the same path as full Newton with the tangent predictor: the limit point
+/// of the imperfect Roorda frame within 2e-3 relative. That is twice the path's own
+/// location tolerance (a step crossing a change of the tangent's inertia is shortened to
+/// 1e-3 of λ, `LOCATE`): the two runs bracket the same point from different steps. What they
+/// save is measured by the benchmarks (docs/nonlinear.md "Speed"), not asserted here.
+#[test]
+fn fast_path_options_find_the_same_limit_points() {
+    let fast = |o: PathOptions| PathOptions {
+        modified_newton: true,
+        secant_predictor: true,
+        ..o
+    };
+    let (m, _) = roorda_frame(20);
+    let lba = buckling(
+        &m,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let lam_lba = lba.factors[0];
+    // The sign whose path has a limit point (the other rises on the stable branch of the
+    // asymmetric bifurcation to λ_max).
+    let cases: Vec<(String, ShellModel, PathOptions)> = vec![(
+        "Roorda frame, w0 = 0.001".into(),
+        with_imperfection(&m, &lba.modes[0], 1e-3).unwrap(),
+        PathOptions {
+            initial_increment: 0.2 * lam_lba,
+            lambda_max: 1.5 * lam_lba,
+            max_steps: 80,
+            ..Default::default()
+        },
+    )];
+    for (name, model, opt) in cases {
+        let slow = run(&model, &opt);
+        let quick = run(&model, &fast(opt.clone()));
+        let (a, b) = (
+            slow.limit.expect("default options: no limit point").lambda,
+            quick.limit.expect("fast options: no limit point").lambda,
+        );
+        println!(
+            "{name}: limit {a:.6} ({} LDLᵀ) vs fast {b:.6} ({} LDLᵀ, {} force evaluations)",
+            slow.stats.factorizations, quick.stats.factorizations, quick.stats.force_evaluations
+        );
+        assert!((b / a - 1.0).abs() < 2e-3, "{name}: {a} vs {b}");
+        for s in &quick.steps {
+            assert!(s.residual <= opt.tolerance);
+        }
+    }
+}
+
+/// The claim behind running one imperfection sign (docs/collapse.md §1): a standing strip
+/// (clamped at its foot, loaded by its own weight along the strip) is its own mirror image
+/// about its mid-surface plane, and its lowest mode (out of that plane) is antisymmetric about
+/// it, so `mirror_symmetries` must find that plane, and the paths from X + w0·φ and X − w0·φ
+/// must be mirror images: the same λ at every step and opposite out-of-plane tip deflections,
+/// to 1e-9 relative (round-off of the mirrored arithmetic only).
+#[test]
+fn mirror_images_have_the_same_path() {
+    let (l, b, t) = (1.0, 0.1, 0.01);
+    let mut m = strip(l, b, t, 1e6, 20);
+    // Greenhill: a standing column buckles under its own weight at q L³ = 7.837 EI; γ chosen
+    // so that λ_LBA ≈ 1.
+    let ei = 1e6 * b * t * t * t / 12.0;
+    let gamma = 7.837 * ei / (l * l * l) / (b * t);
+    m.materials = vec![material(1e6, 0.0, gamma)];
+    m.gravity = [-1.0, 0.0, 0.0];
+    let lba = buckling(
+        &m,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (lam, mode) = (lba.factors[0], &lba.modes[0]);
+    assert!((lam - 1.0).abs() < 0.05, "Greenhill λ_LBA {lam}");
+    let mirrors = kappe_fe::nonlinear::mirror_symmetries(&m, 1e-9);
+    assert!(
+        mirrors.iter().any(|mi| mi.is_antisymmetric(mode, 1e-6)),
+        "{mirrors:?}"
+    );
+    let opt = PathOptions {
+        initial_increment: 0.5 * lam,
+        lambda_max: 1.3 * lam,
+        ..Default::default()
+    };
+    let tip = m.nodes.len() - 1;
+    let path = |s: f64| run(&with_imperfection(&m, mode, s * 0.01 * l).unwrap(), &opt);
+    let (p, q) = (path(1.0), path(-1.0));
+    assert_eq!(p.steps.len(), q.steps.len());
+    for (a, c) in p.steps.iter().zip(&q.steps) {
+        assert!(
+            (a.lambda - c.lambda).abs() <= 1e-9 * a.lambda.abs(),
+            "{} vs {}",
+            a.lambda,
+            c.lambda
+        );
+        let (za, zc) = (a.displacements[tip][2], c.displacements[tip][2]);
+        assert!(
+            (za + zc).abs() <= 1e-9 * za.abs().max(1e-12),
+            "{za} vs {zc}"
+        );
+    }
+    println!(
+        "standing strip: λ_LBA {lam:.4}, {} steps to λ = {:.4}, tip w = ±{:.4e} m",
+        p.steps.len(),
+        p.steps.last().map_or(0.0, |s| s.lambda),
+        p.steps
+            .last()
+            .map_or(0.0, |s| s.displacements[tip][2].abs())
+    );
+}

@@ -22,7 +22,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::buckling::state_material_with;
-use crate::analysis::shell::{NoShell, state_shell};
+use crate::analysis::shell::{NoShell, StateShell, state_shell};
 use crate::form::cap::Cap;
 use crate::form::states::{Role, build_state};
 use crate::input::analysis::AnalysisOptions;
@@ -215,6 +215,7 @@ pub fn cap_increment(
         // A single layer lies on the bed: every node is supported, nothing moves.
         Err(NoShell::SingleLayer) => return Ok(Increment::default()),
     };
+    let keys = node_keys(&state, &shell);
     let mut model = shell.model;
     let n_el = model.triangles.len();
     model.materials = (0..n_el)
@@ -231,24 +232,28 @@ pub fn cap_increment(
             m
         })
         .collect();
+    increment(&model, &keys).map_err(|e| DesignError::State {
+        state: top,
+        message: format!("as-printed increment failed: {e}"),
+    })
+}
+
+/// The key of every node of a state's shell (None: a node not tracked, e.g. a column end).
+pub fn node_keys(state: &crate::form::states::State, shell: &StateShell) -> Vec<Option<NodeKey>> {
     let mut first: HashMap<i32, usize> = HashMap::new();
     for (i, n) in state.network.nodes.iter().enumerate() {
         if n.role != Role::ColumnEnd {
             first.entry(n.layer).or_insert(i);
         }
     }
-    let keys: Vec<Option<NodeKey>> = shell
+    shell
         .network_node
         .iter()
         .map(|&i| {
             let layer = state.network.nodes.get(i)?.layer;
             Some((layer, i.checked_sub(*first.get(&layer)?)?))
         })
-        .collect();
-    increment(&model, &keys).map_err(|e| DesignError::State {
-        state: top,
-        message: format!("as-printed increment failed: {e}"),
-    })
+        .collect()
 }
 
 /// The as-printed shape of `cap` over every print state (increments in parallel, summed in

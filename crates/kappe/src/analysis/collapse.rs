@@ -102,11 +102,18 @@ pub struct Collapse {
     pub curve: Vec<[f64; 2]>,
     /// Tangent assemblies over all paths run.
     pub assemblies: usize,
+    /// Numeric LDLᵀ factorizations of the tangent over all paths run (the benchmark's count;
+    /// not in the outputs).
+    #[serde(skip)]
+    pub factorizations: usize,
 }
 
 /// Most points of [`Collapse::curve`]: enough to draw a smooth curve, few enough for the
 /// report input.
 pub const CURVE_POINTS: usize = 64;
+
+/// The stop reason of a path that passed the other sign's collapse factor.
+const ABOVE_OTHER_SIGN: &str = "above the other sign's collapse factor";
 
 /// Every k-th point of `v` so at most `n` remain, always keeping the last.
 fn thin(v: Vec<[f64; 2]>, n: usize) -> Vec<[f64; 2]> {
@@ -147,15 +154,20 @@ pub fn collapse_factor(
             steps: 0,
             curve: Vec::new(),
             assemblies: 0,
+            factorizations: 0,
         });
     }
-    let signs: &[f64] = if options.signs >= 2 {
+    let signs: &[f64] = if options.signs >= 2
+        && options.w0 != 0.0
+        && !mirror_antisymmetric(model, mode, options.w0, elements, ages)
+    {
         &[1.0, -1.0]
     } else {
         &[1.0]
     };
     let mut best: Option<Collapse> = None;
     let mut assemblies = 0;
+    let mut factorizations = 0;
     for &sign in signs {
         let c = one_path(
             model,
@@ -167,8 +179,10 @@ pub fn collapse_factor(
             time,
             options,
             sign,
+            best.as_ref().map_or(f64::INFINITY, |b| b.factor),
         )?;
         assemblies += c.assemblies;
+        factorizations += c.factorizations;
         if best.as_ref().is_none_or(|b| c.factor < b.factor) {
             best = Some(c);
         }
@@ -179,7 +193,41 @@ pub fn collapse_factor(
     }
     let mut best = best.ok_or_else(|| DesignError::FormFinding("collapse: no path run".into()))?;
     best.assemblies = assemblies;
+    best.factorizations = factorizations;
     Ok(best)
+}
+
+/// Whether the state is its own mirror image and its mode antisymmetric about the mirror
+/// (`kappe_fe::nonlinear::mirror_symmetry`): then the imperfect states X ± w0·φ are mirror
+/// images of each other, so are their paths and material checks, and one sign gives the
+/// collapse factor of both (docs/collapse.md §1). Nodes must mirror onto nodes within
+/// 1e-3·w0 and the mode be antisymmetric within 1e-3 of its largest translation: the two
+/// imperfect geometries then differ from exact mirror images by at most ~2e-3·w0, whose effect
+/// on λ is far below the path's 1e-3 location tolerance (λ changes by well under 10 % over the
+/// whole range 0…w0, §4). With the material check, mirrored elements must also have the same
+/// younger layer age and mirrored bed normals.
+fn mirror_antisymmetric(
+    model: &ShellModel,
+    mode: &[[f64; 6]],
+    w0: f64,
+    elements: &[ElementLayers],
+    ages: &[f64],
+) -> bool {
+    let age = |e: &ElementLayers| ages.get(e.younger).copied();
+    kappe_fe::nonlinear::mirror_symmetries(model, 1e-3 * w0.abs())
+        .iter()
+        .any(|m| {
+            m.is_antisymmetric(mode, 1e-3)
+                && elements.iter().enumerate().all(|(e, info)| {
+                    let Some(other) = m.element_map.get(e).and_then(|&f| elements.get(f)) else {
+                        return false;
+                    };
+                    let r = m.reflect(info.bed_normal);
+                    let o = other.bed_normal;
+                    let d = (r[0] * o[0] + r[1] * o[1] + r[2] * o[2]).abs();
+                    age(info) == age(other) && (d - 1.0).abs() <= 1e-9
+                })
+        })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -193,6 +241,7 @@ fn one_path(
     time: &TimeModel,
     options: &CollapseOptions,
     sign: f64,
+    above: f64,
 ) -> Result<Collapse, DesignError> {
     let fe = |e: kappe_fe::FeError| DesignError::FormFinding(format!("collapse path: {e}"));
     let imperfect = kappe_fe::with_imperfection(model, mode, sign * options.w0).map_err(fe)?;
@@ -202,6 +251,9 @@ fn one_path(
     let opt = PathOptions {
         initial_increment: 0.5 * lba.min(lam_mat),
         lambda_max: 1.5 * lba,
+        // docs/collapse.md §6: the same path at a fraction of the factorizations.
+        modified_newton: true,
+        secant_predictor: true,
         ..Default::default()
     };
     let check_material = (options.strength || options.sliding) && time.strength.is_some();
@@ -211,6 +263,18 @@ fn one_path(
     let mut material: Option<(f64, CollapseMode)> = None;
     let mut deflection_at_1 = 0.0;
     let mut material_error: Option<DesignError> = None;
+    // Once a path has passed `above` (the other sign's collapse factor) before its own limit
+    // point or material failure, its own collapse factor is higher: every later limit or
+    // failure lies at a λ at least that of a step already passed (a load maximum's vertex is
+    // at or above the steps around it, a bifurcation or a failure lies between a step and the
+    // next higher one). It cannot govern, so it stops there.
+    let beyond = |step: &kappe_fe::PathStep| {
+        if step.lambda > above && !step.limit_passed {
+            ControlFlow::Break(StopReason::Caller(ABOVE_OTHER_SIGN.into()))
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
     let path = kappe_fe::nonlinear_path(&imperfect, &opt, &mut |step| {
         if step.lambda <= 1.0 {
             deflection_at_1 = step
@@ -220,7 +284,7 @@ fn one_path(
                 .fold(0.0, f64::max);
         }
         if !check_material {
-            return ControlFlow::Continue(());
+            return beyond(step);
         }
         let res = match kappe_fe::deformed_resultants(&imperfect, &step.displacements) {
             Ok(r) => r,
@@ -260,9 +324,9 @@ fn one_path(
             ControlFlow::Break(StopReason::Caller(m.name().into()))
         } else if step.lambda > last.0 {
             last = (step.lambda, u);
-            ControlFlow::Continue(())
+            beyond(step)
         } else {
-            ControlFlow::Continue(())
+            beyond(step)
         }
     })
     .map_err(fe)?;
@@ -283,6 +347,9 @@ fn one_path(
         (None, Some((m, mm))) => (m, mm),
         (None, None) => match path.stop {
             StopReason::LambdaMax => (last_lambda, CollapseMode::NotReached),
+            StopReason::Caller(ref r) if r == ABOVE_OTHER_SIGN => {
+                (last_lambda, CollapseMode::NotReached)
+            }
             _ => (last_lambda, CollapseMode::NoConvergence),
         },
     };
@@ -310,6 +377,7 @@ fn one_path(
         steps: path.steps.len(),
         curve: thin(curve, CURVE_POINTS),
         assemblies: path.stats.assemblies,
+        factorizations: path.stats.factorizations,
     })
 }
 
@@ -374,6 +442,71 @@ pub fn cap_states_to_run(
     Ok(done)
 }
 
+/// A cap state's model and its linear buckling solve, as the collapse check starts from them
+/// ([`cap_state_lba`]).
+pub struct StateLba {
+    /// The print state.
+    pub state: crate::form::states::State,
+    /// The state's shell (full print-layer mesh with the aged moduli).
+    pub shell: crate::analysis::shell::StateShell,
+    /// The LBA: factor and lowest mode; `None` when the state is a mechanism.
+    pub lba: Option<(f64, Vec<[f64; 6]>)>,
+}
+
+/// The model of cap state `top` and its linear buckling solve (the first half of
+/// [`cap_state_collapse`]; public so the benchmark can time the LBA alone). `None`: no shell
+/// (one layer).
+pub fn cap_state_lba(
+    cap: &crate::form::cap::Cap,
+    options: &crate::input::analysis::AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+) -> Result<Option<StateLba>, DesignError> {
+    let state = crate::form::states::build_state(
+        &cap.sections,
+        &cap.frame,
+        cap.design.print.start_arch_fraction,
+        top,
+    )?;
+    let mat = crate::analysis::buckling::state_material_with(cap, options, top, green);
+    let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
+        return Ok(None);
+    };
+    let lba = match kappe_fe::buckling(
+        &shell.model,
+        &kappe_fe::BucklingOptions {
+            modes: 1,
+            // As the LBA check (buckling.rs): far below any modelling error.
+            tolerance: 1e-8,
+            ..Default::default()
+        },
+    ) {
+        Ok(r) => r,
+        Err(kappe_fe::FeError::Mechanism { .. }) => {
+            return Ok(Some(StateLba {
+                state,
+                shell,
+                lba: None,
+            }));
+        }
+        Err(e) => {
+            return Err(DesignError::State {
+                state: top,
+                message: format!("buckling solve for the collapse check failed: {e}"),
+            });
+        }
+    };
+    let lba = lba
+        .factors
+        .first()
+        .copied()
+        .zip(lba.modes.into_iter().next());
+    if lba.is_none() {
+        return Ok(None);
+    }
+    Ok(Some(StateLba { state, shell, lba }))
+}
+
 /// The collapse of one cap state (top print index `top`) on its full shell mesh: its LBA
 /// (mode 1 on the shell's nodes), the imperfection rule with the shell's thickness and the
 /// state's height above its lowest node, and the path with the aged material (`green`: the
@@ -385,50 +518,25 @@ pub fn cap_state_collapse(
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
 ) -> Result<Option<Collapse>, DesignError> {
-    let state = crate::form::states::build_state(
-        &cap.sections,
-        &cap.frame,
-        cap.design.print.start_arch_fraction,
-        top,
-    )?;
-    let mat = crate::analysis::buckling::state_material_with(cap, options, top, green);
-    let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
+    let Some(StateLba { state, shell, lba }) = cap_state_lba(cap, options, green, top)? else {
         return Ok(None);
     };
     let model = &shell.model;
-    let lba = match kappe_fe::buckling(
-        model,
-        &kappe_fe::BucklingOptions {
-            modes: 1,
-            // As the LBA check (buckling.rs): far below any modelling error.
-            tolerance: 1e-8,
-            ..Default::default()
-        },
-    ) {
-        Ok(r) => r,
-        Err(kappe_fe::FeError::Mechanism { .. }) => {
-            return Ok(Some(Collapse {
-                factor: 0.0,
-                mode: CollapseMode::Mechanism,
-                lba: 0.0,
-                w0: 0.0,
-                sign: 1.0,
-                deflection_at_1: 0.0,
-                steps: 0,
-                curve: Vec::new(),
-                assemblies: 0,
-            }));
-        }
-        Err(e) => {
-            return Err(DesignError::State {
-                state: top,
-                message: format!("buckling solve for the collapse check failed: {e}"),
-            });
-        }
+    let Some((blf, mode)) = lba else {
+        return Ok(Some(Collapse {
+            factor: 0.0,
+            mode: CollapseMode::Mechanism,
+            lba: 0.0,
+            w0: 0.0,
+            sign: 1.0,
+            deflection_at_1: 0.0,
+            steps: 0,
+            curve: Vec::new(),
+            assemblies: 0,
+            factorizations: 0,
+        }));
     };
-    let (Some(&blf), Some(mode)) = (lba.factors.first(), lba.modes.first()) else {
-        return Ok(None);
-    };
+    let mode = &mode;
     let (zmin, zmax) = model
         .nodes
         .iter()
@@ -436,6 +544,15 @@ pub fn cap_state_collapse(
             (a.min(p[2]), b.max(p[2]))
         });
     let w0 = spec.amplitude(model.thickness_of(0), (zmax - zmin).max(0.0));
+    let start;
+    let model = match spec.start {
+        crate::input::nonlinear::PathStart::Design => model,
+        crate::input::nonlinear::PathStart::AsPrinted => {
+            let shift = cap_as_printed_shift(cap, options, green, top, &state, &shell)?;
+            start = shifted(model, &shift);
+            &start
+        }
+    };
     let (elements, ages, time) = match green {
         Some(g) => (
             g.element_layers(&shell),
@@ -478,4 +595,117 @@ pub fn cap_state_collapse(
         },
     )
     .map(Some)
+}
+
+/// `model` with every node moved by `shift` (m).
+pub fn shifted(model: &ShellModel, shift: &[[f64; 3]]) -> ShellModel {
+    let mut out = model.clone();
+    for (p, d) in out.nodes.iter_mut().zip(shift) {
+        (0..3).for_each(|k| p[k] += d[k]);
+    }
+    out
+}
+
+/// The deviation cap state `top`'s print has locked into its geometry (docs/collapse.md §8):
+/// per shell node, its as-printed displacement (the sum of the increments of the states from
+/// the one it was laid in up to `top`, `crate::analysis::asprinted`) minus the state's own
+/// linear displacement under its whole weight. The path then starts stress-free from the
+/// design moved by this and reaches, at λ = 1 in the linear range, the as-printed shape.
+/// Nodes the as-printed pass does not track (column ends) stay at the design.
+///
+/// # Errors
+/// An increment or the static solve fails.
+pub fn cap_as_printed_shift(
+    cap: &crate::form::cap::Cap,
+    options: &crate::input::analysis::AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    state: &crate::form::states::State,
+    shell: &crate::analysis::shell::StateShell,
+) -> Result<Vec<[f64; 3]>, DesignError> {
+    use rayon::prelude::*;
+    let increments = (0..=top)
+        .into_par_iter()
+        .map(|k| crate::analysis::asprinted::cap_increment(cap, options, green, k))
+        .collect::<Result<Vec<_>, DesignError>>()?;
+    let mut printed: std::collections::HashMap<crate::analysis::asprinted::NodeKey, [f64; 3]> =
+        std::collections::HashMap::new();
+    for inc in &increments {
+        for (key, _, du) in &inc.nodes {
+            let e = printed.entry(*key).or_insert([0.0; 3]);
+            (0..3).for_each(|k| e[k] += du[k]);
+        }
+    }
+    let keys = crate::analysis::asprinted::node_keys(state, shell);
+    let own = kappe_fe::linear_static(&shell.model).map_err(|e| DesignError::State {
+        state: top,
+        message: format!("static solve for the as-printed start failed: {e}"),
+    })?;
+    Ok(as_printed_shift(
+        keys.iter()
+            .map(|k| k.and_then(|k| printed.get(&k).copied())),
+        &own.displacements,
+    ))
+}
+
+/// Per node: the as-printed displacement (None: not tracked, no shift) minus the node's own
+/// linear displacement `own`.
+pub fn as_printed_shift(
+    printed: impl Iterator<Item = Option<[f64; 3]>>,
+    own: &[[f64; 6]],
+) -> Vec<[f64; 3]> {
+    printed
+        .zip(own)
+        .map(|(p, d)| p.map_or([0.0; 3], |p| [p[0] - d[0], p[1] - d[1], p[2] - d[2]]))
+        .collect()
+}
+
+/// The deviation an `n`-layer buildability object's print locks into its geometry, as
+/// [`cap_as_printed_shift`]: `shell(k)` is the k-layer object (its nodes numbered row by row
+/// from the bed, the same in every k), `ages(k)` its layers' ages, `own` the n-layer model
+/// with its aged moduli. Layer count k adds the weight of its top strip (elements whose
+/// younger layer is k − 1) on the k-layer object with the moduli at its ages; a node's
+/// as-printed displacement is the sum over the counts it exists in.
+///
+/// # Errors
+/// A static solve fails.
+pub fn object_as_printed_shift(
+    n: usize,
+    shell: &(dyn Fn(usize) -> (ShellModel, Vec<ElementLayers>) + Sync),
+    ages: &(dyn Fn(usize) -> Vec<f64> + Sync),
+    time: &TimeModel,
+    own: &ShellModel,
+) -> Result<Vec<[f64; 3]>, DesignError> {
+    use rayon::prelude::*;
+    let fe = |e: kappe_fe::FeError| DesignError::FormFinding(format!("as-printed start: {e}"));
+    let increments = (1..=n)
+        .into_par_iter()
+        .map(|k| {
+            let (mut m, layers) = shell(k);
+            crate::analysis::green::set_aged_moduli(&mut m, &layers, &ages(k), time);
+            m.materials = (0..m.triangles.len())
+                .map(|e| {
+                    let mut mat = m.material_of(e);
+                    if layers.get(e).is_none_or(|l| l.younger + 1 != k) {
+                        mat.unit_weight = 0.0;
+                    }
+                    mat
+                })
+                .collect();
+            kappe_fe::linear_static(&m)
+                .map(|r| r.displacements)
+                .map_err(fe)
+        })
+        .collect::<Result<Vec<_>, DesignError>>()?;
+    let mut printed = vec![[0.0; 3]; own.nodes.len()];
+    for du in &increments {
+        for (p, d) in printed.iter_mut().zip(du) {
+            (0..3).for_each(|c| p[c] += d[c]);
+        }
+    }
+    let own = kappe_fe::linear_static(own).map_err(fe)?;
+    Ok(as_printed_shift(
+        printed.into_iter().map(Some),
+        &own.displacements,
+    ))
 }

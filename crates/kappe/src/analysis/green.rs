@@ -231,18 +231,7 @@ pub fn solve_state(
     want_stress: bool,
 ) -> Result<SolvedState, DesignError> {
     let mut mode = None;
-    let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
-    let base = model.material_of(0);
-    if !time.is_constant() {
-        model.materials = elements
-            .iter()
-            .map(|e| Material {
-                youngs_modulus: 0.5
-                    * (time.modulus(age(e.stiffness.0)) + time.modulus(age(e.stiffness.1))),
-                ..base
-            })
-            .collect();
-    }
+    set_aged_moduli(model, elements, ages, time);
     let (buckling, static_result) = if options.buckling {
         let opts = BucklingOptions {
             modes: 1,
@@ -285,6 +274,28 @@ pub fn solve_state(
     };
 
     Ok((buckling, static_result, mode))
+}
+
+/// Every element's E the mean of its two layers' moduli at their ages (`ages[k]`: the age of
+/// the layer with print index k, s); the model's own material for a constant time model.
+pub fn set_aged_moduli(
+    model: &mut ShellModel,
+    elements: &[ElementLayers],
+    ages: &[f64],
+    time: &TimeModel,
+) {
+    let age = |k: usize| ages.get(k).copied().unwrap_or(0.0);
+    let base = model.material_of(0);
+    if !time.is_constant() {
+        model.materials = elements
+            .iter()
+            .map(|e| Material {
+                youngs_modulus: 0.5
+                    * (time.modulus(age(e.stiffness.0)) + time.modulus(age(e.stiffness.1))),
+                ..base
+            })
+            .collect();
+    }
 }
 
 /// Buckling outcome, the static solution (None: not solved or a mechanism) and mode 1.

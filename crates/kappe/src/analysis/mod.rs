@@ -60,8 +60,11 @@ pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
 pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
 pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
-pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
+pub use collapse::{
+    CURVE_POINTS, CollapseMode, StateLba, cap_as_printed_shift, cap_state_collapse, cap_state_lba,
+    object_as_printed_shift, shifted,
+};
 pub use graded::{Grading, graded_rows, graded_state};
-pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
+pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli};
 pub use reliability::{Check, Vars, check_form, limit_state, prepare, state_form};
 pub use shell::state_shell;

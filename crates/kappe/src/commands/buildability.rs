@@ -22,13 +22,15 @@ use serde::{Deserialize, Serialize};
 
 use kappe_fe::{Material, ShellModel, Support};
 
-use crate::analysis::collapse::{Collapse, CollapseMode, CollapseOptions, collapse_factor};
+use crate::analysis::collapse::{
+    Collapse, CollapseMode, CollapseOptions, collapse_factor, object_as_printed_shift, shifted,
+};
 use crate::analysis::green::{
     BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement, check_state,
 };
 use crate::input::error::DesignError;
 use crate::input::material::{TimeModel, TimeModelSpec};
-use crate::input::nonlinear::{BaseRestraint, NonlinearSpec};
+use crate::input::nonlinear::{BaseRestraint, NonlinearSpec, PathStart};
 use crate::schedule::{Schedule, ScheduleSpec};
 
 /// The test object.
@@ -586,8 +588,22 @@ pub fn check_layers_warm(
                 sliding: c.sliding && nl.material,
             };
             let shape = mode.clone().unwrap_or_default();
+            // docs/collapse.md §8: the path from the as-printed geometry.
+            let start = match nl.start {
+                PathStart::Design => None,
+                PathStart::AsPrinted => Some(shifted(
+                    &model,
+                    &object_as_printed_shift(
+                        n,
+                        &|k| object_shell(r, k),
+                        &|k| r.schedule.ages(k),
+                        &r.time,
+                        &model,
+                    )?,
+                )),
+            };
             Some(collapse_factor(
-                &model,
+                start.as_ref().unwrap_or(&model),
                 &shape,
                 blf,
                 g.strength.map(|w| w.utilisation),

@@ -22,5 +22,5 @@ pub use error::DesignError;
 pub use analysis::AnalysisOptions;
 pub use design::EXAMPLE_TOML;
 pub use material::{TimeLaw, TimeModel, TimeModelSpec};
-pub use nonlinear::NonlinearSpec;
+pub use nonlinear::{NonlinearSpec, PathStart};
 pub use uncertainty::{BETA_MIN_DEFAULT, UncertaintyTable};

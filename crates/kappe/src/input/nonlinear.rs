@@ -26,6 +26,34 @@ impl BaseRestraint {
     }
 }
 
+/// The geometry a state's collapse path starts from (docs/collapse.md §8), before the mode
+/// imperfection is added.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PathStart {
+    /// The design geometry (default).
+    #[default]
+    Design,
+    /// The as-printed geometry: the design moved by the deviation the print locks in (each
+    /// layer laid at its programmed position onto the sagged earlier ones), i.e. the
+    /// as-printed displacement minus the state's own linear displacement under its weight.
+    AsPrinted,
+}
+
+impl PathStart {
+    /// The name used in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            PathStart::Design => "design",
+            PathStart::AsPrinted => "as_printed",
+        }
+    }
+
+    fn is_design(&self) -> bool {
+        *self == PathStart::Design
+    }
+}
+
 /// `[analysis.nonlinear]`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -47,6 +75,9 @@ pub struct NonlinearSpec {
     pub signs: Option<usize>,
     /// Check Mohr–Coulomb strength and bed-joint sliding at the shell's faces along the path.
     pub material: bool,
+    /// The geometry the path starts from: `"design"` (default) or `"as_printed"`.
+    #[serde(skip_serializing_if = "PathStart::is_design")]
+    pub start: PathStart,
 }
 
 impl Default for NonlinearSpec {
@@ -58,6 +89,7 @@ impl Default for NonlinearSpec {
             base: BaseRestraint::Clamped,
             signs: None,
             material: true,
+            start: PathStart::Design,
         }
     }
 }

@@ -192,3 +192,106 @@ fn a_state_fails_by_collapse_below_collapse_min() {
     let s = check_layers(&r, 3).unwrap();
     assert_eq!(s.failure, Some(FailureMode::Collapse));
 }
+
+/// The as-printed start (docs/collapse.md §8) on the Wolfs cylinder: the shift is the sum of
+/// the layer counts' increments minus the state's own linear displacement.
+/// - One layer: the print has nothing to lock in (one increment, equal to the state's own
+///   displacement): the shift is zero to round-off (1e-9 of the sag).
+/// - More layers: each layer was laid level onto the sagged ones, so the top row sits higher
+///   than the all-at-once solution puts it (its own weight and the layers above it did not
+///   load it while it was being placed): the shift is upward at the top (at least 1 % of the
+///   state's own sag there, far above round-off), zero at the held bed, and the path from the
+///   shifted geometry with w0 = 0 still finds a collapse factor within 10 % of the design
+///   start's (the shift is a fraction of a millimetre on a 40 mm wall).
+#[test]
+fn the_as_printed_start_locks_in_the_staged_sag() {
+    use kappe::analysis::{object_as_printed_shift, set_aged_moduli};
+    use kappe::commands::buildability::object_shell;
+    let r = cylinder("imperfection = 0.0");
+    let shift_of = |n: usize| {
+        let (mut own, layers) = object_shell(&r, n);
+        set_aged_moduli(&mut own, &layers, &r.schedule.ages(n), &r.time);
+        let own_u = kappe_fe::linear_static(&own).unwrap().displacements;
+        let shift = object_as_printed_shift(
+            n,
+            &|k| object_shell(&r, k),
+            &|k| r.schedule.ages(k),
+            &r.time,
+            &own,
+        )
+        .unwrap();
+        (own, own_u, shift)
+    };
+    let (_, u1, s1) = shift_of(1);
+    let sag1 = u1.iter().map(|d| d[2].abs()).fold(0.0, f64::max);
+    assert!(sag1 > 0.0);
+    let worst1 = s1
+        .iter()
+        .flat_map(|d| d.iter())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        worst1 <= 1e-9 * sag1,
+        "one layer: shift {worst1} vs sag {sag1}"
+    );
+    let n = 10;
+    let (own, u, s) = shift_of(n);
+    let cols = own.nodes.len() / (n + 1);
+    let top = &s[n * cols..];
+    let sag_top = u[n * cols..].iter().map(|d| -d[2]).fold(0.0, f64::max);
+    let lift = top.iter().map(|d| d[2]).fold(f64::INFINITY, f64::min);
+    assert!(
+        lift > 0.01 * sag_top,
+        "top lift {lift} vs its sag {sag_top}"
+    );
+    assert!(s[..cols].iter().all(|d| d.iter().all(|v| *v == 0.0)));
+    let design = check_layers(&cylinder("imperfection = 0.0"), n).unwrap();
+    let printed = check_layers(&cylinder("imperfection = 0.0\nstart = \"as_printed\""), n).unwrap();
+    let (a, b) = (design.collapse.unwrap(), printed.collapse.unwrap());
+    println!(
+        "n = {n}: design start {:.4} {}, as-printed start {:.4} {}; top lift {lift:.3e} m, own sag {sag_top:.3e} m",
+        a.factor,
+        a.mode.name(),
+        b.factor,
+        b.mode.name()
+    );
+    assert!((b.factor / a.factor - 1.0).abs() < 0.1, "{a:?} vs {b:?}");
+}
+
+/// One imperfection sign where the mirror image gives the other (docs/collapse.md §1): a
+/// straight wall is its own mirror image about its mid-surface plane and its lowest mode (out
+/// of that plane) is antisymmetric about it, so `signs = 2` runs one path, the same as
+/// `signs = 1` (bit for bit, at half the factorizations of two paths). The physics of the
+/// claim (X ± w0·φ mirror images give equal paths) and a state where it does not hold
+/// (Roorda's frame) are checked in fe's `mirror_images_have_the_same_path`.
+#[test]
+fn a_straight_wall_runs_one_sign() {
+    let wall = |extra: &str| {
+        let text = EXAMPLE_TOML
+            .replace("# segments = 48", "segments = 24")
+            .replace("kind = \"cylinder\"", "kind = \"wall\"")
+            .replace("# length = 1.0", "length = 1.0");
+        BuildabilitySpec::from_toml_str(&format!(
+            "{text}\n[analysis.nonlinear]\nmaterial = false\n{extra}\n"
+        ))
+        .unwrap()
+    };
+    let n = 8;
+    let two = check_layers(&wall("signs = 2"), n)
+        .unwrap()
+        .collapse
+        .unwrap();
+    let one = check_layers(&wall("signs = 1"), n)
+        .unwrap()
+        .collapse
+        .unwrap();
+    println!(
+        "wall n = {n}: signs = 2 → {:.6} {} ({} LDLᵀ); signs = 1 → {:.6} ({} LDLᵀ)",
+        two.factor,
+        two.mode.name(),
+        two.factorizations,
+        one.factor,
+        one.factorizations
+    );
+    assert_eq!(two.factor, one.factor);
+    assert_eq!(two.factorizations, one.factorizations);
+}
