@@ -8,8 +8,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::asprinted::Increment;
+use super::bending::BendingSummary;
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_printed,
+    BucklingRequest, BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_with,
     state_material_with,
 };
 use super::stress::{
@@ -363,26 +364,37 @@ pub fn state_fe(
     top: usize,
     guess: &mut Option<ModeGuess>,
 ) -> Result<StateFe, DesignError> {
-    state_fe_first(cap, options, green, top, guess, false).map(|(f, _)| f)
+    state_fe_first(cap, options, green, top, guess, false).map(|f| f.fe)
 }
 
-/// [`state_fe`] and, with `printed`, the state's as-printed increment solved inside its
-/// buckling solve (`state_buckling_printed`; `None` where that solve cannot give it).
+/// What a state's first-pass solve ([`state_fe_first`]) gives beyond its [`StateFe`].
+struct FirstSolve {
+    fe: StateFe,
+    /// The as-printed increment, solved inside the buckling solve (`None` where that solve
+    /// cannot give it).
+    increment: Option<Increment>,
+    /// A corrugated state's stress extremes with its bending part, solved inside the buckling
+    /// solve (`None` where that solve cannot give them: phase 1 of [`assemble`] solves them).
+    stresses: Option<(StressExtremes, Option<BendingSummary>)>,
+}
+
+/// [`state_fe`] and, with `extra`, what the buckling solve's factor of K also gives: the
+/// state's as-printed increment and a corrugated state's bending part.
 fn state_fe_first(
     cap: &Cap,
     options: &AnalysisOptions,
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
     guess: &mut Option<ModeGuess>,
-    printed: bool,
-) -> Result<(StateFe, Option<Increment>), DesignError> {
+    extra: bool,
+) -> Result<FirstSolve, DesignError> {
     // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
     // all states together ([`converge_fe`]).
     let first = AnalysisOptions {
         blf_max_split: 1,
         ..options.clone()
     };
-    state_fe_printed(cap, &first, green, top, guess, printed)
+    state_fe_printed(cap, &first, green, top, guess, extra)
 }
 
 /// [`state_fe`] with the options as given (`blf_max_split` > 1: the split meshes too).
@@ -393,18 +405,18 @@ fn state_fe_with(
     top: usize,
     guess: &mut Option<ModeGuess>,
 ) -> Result<StateFe, DesignError> {
-    state_fe_printed(cap, options, green, top, guess, false).map(|(f, _)| f)
+    state_fe_printed(cap, options, green, top, guess, false).map(|f| f.fe)
 }
 
-/// [`state_fe_with`] and, with `printed`, the as-printed increment of [`state_fe_first`].
+/// [`state_fe_with`] and, with `extra`, what [`state_fe_first`] gives beyond it.
 fn state_fe_printed(
     cap: &Cap,
     options: &AnalysisOptions,
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
     guess: &mut Option<ModeGuess>,
-    printed: bool,
-) -> Result<(StateFe, Option<Increment>), DesignError> {
+    extra: bool,
+) -> Result<FirstSolve, DesignError> {
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
@@ -415,17 +427,25 @@ fn state_fe_printed(
         Some(g) => g.state_checks(&state, &mat, options, top)?,
         None => None,
     };
-    let (buckling, mode, green, increment) = match checked {
-        Some((b, mode, green)) => (b, mode, green, None),
+    let (buckling, mode, green, increment, stresses) = match checked {
+        Some((b, mode, green)) => (b, mode, green, None, None),
         _ => {
-            let (b, mode, next, increment) =
-                state_buckling_printed(&state, &mat, options, guess.as_ref(), printed)?;
-            *guess = Some(next);
-            (b, mode, None, increment)
+            let request = BucklingRequest {
+                guess: guess.as_ref(),
+                printed: extra,
+                // Phase 1 of `assemble` adds the bending part to a corrugated cap's stresses.
+                bending: (extra && !cap.centre_arches.is_empty()).then(|| cap.areas()),
+            };
+            let r = state_buckling_with(&state, &mat, options, &request)?;
+            *guess = Some(r.next);
+            let stresses = r
+                .stresses
+                .map(|(all, bending)| (StressExtremes::of(&all), bending));
+            (r.buckling, r.mode, None, r.increment, stresses)
         }
     };
-    Ok((
-        StateFe {
+    Ok(FirstSolve {
+        fe: StateFe {
             state: top,
             buckling,
             mode,
@@ -433,7 +453,8 @@ fn state_fe_printed(
             seconds: t0.elapsed().as_secs_f64(),
         },
         increment,
-    ))
+        stresses,
+    })
 }
 
 /// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
@@ -656,6 +677,7 @@ fn analyze_from_fe(
         (t_all, 0.0),
         complete,
         Default::default(),
+        Default::default(),
         context.stop_flag(),
     )
 }
@@ -696,6 +718,9 @@ fn analyze_all(
     // Each state's as-printed increment, solved inside its buckling solve's factorization of K
     // (the as-printed pass then factorizes only the states this pass did not solve).
     let increments = std::sync::Mutex::new(std::collections::HashMap::new());
+    // A corrugated state's stresses with its bending part, likewise (phase 1 of `assemble`
+    // then solves only the states this pass did not).
+    let bending = std::sync::Mutex::new(std::collections::HashMap::new());
     let fe: Vec<StateFe> = runs
         .into_par_iter()
         .map(|run| {
@@ -703,12 +728,20 @@ fn analyze_all(
             let mut out = Vec::with_capacity(run.len());
             for top in run {
                 cancelled()?;
-                let (f, increment) =
-                    state_fe_first(cap, options, green.as_ref(), top, &mut guess, true)?;
+                let FirstSolve {
+                    fe: f,
+                    increment,
+                    stresses,
+                } = state_fe_first(cap, options, green.as_ref(), top, &mut guess, true)?;
                 if let Some(i) = increment
                     && let Ok(mut m) = increments.lock()
                 {
                     m.insert(top, i);
+                }
+                if let Some(x) = stresses
+                    && let Ok(mut m) = bending.lock()
+                {
+                    m.insert(top, x);
                 }
                 if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first())
                     && let Ok(mut m) = first_modes.lock()
@@ -760,6 +793,7 @@ fn analyze_all(
         (t_all, wall_fe),
         true,
         increments.into_inner().unwrap_or_default(),
+        bending.into_inner().unwrap_or_default(),
         stop,
     )
 }
@@ -769,7 +803,8 @@ fn analyze_all(
 /// seconds of the finite-element phase. `complete`: every selected state is in `fe`, so the
 /// whole-print passes run (the as-printed shape; a partial verdict, the designer's while its
 /// workers run, leaves them out rather than pay for them at every result). `increments`: the
-/// as-printed increments the buckling solves already gave (by state; the pass solves the rest).
+/// as-printed increments the buckling solves already gave (by state; the pass solves the rest);
+/// `solved_bending`: likewise a corrugated cap's stresses with their bending part.
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     cap: &Cap,
@@ -780,6 +815,7 @@ fn assemble(
     (t_all, wall_fe): (Instant, f64),
     complete: bool,
     increments: std::collections::HashMap<usize, Increment>,
+    solved_bending: std::collections::HashMap<usize, (StressExtremes, Option<BendingSummary>)>,
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     let cancelled = || {
@@ -795,7 +831,7 @@ fn assemble(
     let phi = design.print.start_arch_fraction;
 
     struct PerState {
-        bending: Option<crate::analysis::bending::BendingSummary>,
+        bending: Option<BendingSummary>,
         stresses: StressExtremes,
         stress_seconds: f64,
         buckling: Option<StateBuckling>,
@@ -843,6 +879,8 @@ fn assemble(
                 // quadratic in the bay length (0.7 GB for a 4 m bay).
                 let (stresses, bending) = if cap.centre_arches.is_empty() {
                     (StressExtremes::of(&element_stresses(&state, areas)?), None)
+                } else if let Some(&solved) = solved_bending.get(&top) {
+                    solved
                 } else {
                     // The bending part of the corrugation (`crate::analysis::bending`).
                     let mat = crate::analysis::buckling::state_material_with(

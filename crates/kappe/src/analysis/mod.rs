@@ -55,7 +55,9 @@ pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
-pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
+pub use buckling::{
+    BucklingRequest, ModeGuess, StateSolve, state_buckling_warm, state_buckling_with, state_refine,
+};
 pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
 pub use graded::{Grading, graded_rows, graded_state};
