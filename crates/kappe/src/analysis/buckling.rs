@@ -35,22 +35,10 @@ pub enum BucklingStatus {
 }
 
 /// The shell material of the state with top print index `top`: the design's material, every
-/// layer's modulus from its age on the cap's schedule when the time model varies with age.
-///
-/// # Errors
-/// An invalid time model or a `[schedule]` that does not fit the print.
+/// layer's modulus from its age on `green`'s schedule (the run's one clock, e.g. the robot
+/// plan's; [`crate::analysis::green::CapGreen::new`]: the cap's own) when the time model varies
+/// with age; `None`: the material without a time model.
 pub fn state_material(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    top: usize,
-) -> Result<ShellMaterial, DesignError> {
-    let green = crate::analysis::green::CapGreen::new(cap)?;
-    Ok(state_material_with(cap, options, top, Some(&green)))
-}
-
-/// [`state_material`] with the layers' ages from `green`'s schedule (the run's one clock, e.g.
-/// the robot plan's); `None`: the material without a time model.
-pub fn state_material_with(
     cap: &Cap,
     options: &AnalysisOptions,
     top: usize,
@@ -106,58 +94,16 @@ impl StateBuckling {
 /// the report draws. Empty when the state has no mode.
 pub type NetworkMode = Vec<(usize, [f64; 3])>;
 
-/// Buckling analysis of one state (shell model + `kappe_fe::buckling`).
-pub fn state_buckling(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-) -> Result<StateBuckling, DesignError> {
-    state_buckling_mode(state, material, options).map(|(b, _)| b)
-}
-
-/// [`state_buckling`] and its first mode shape.
-///
-/// With `converged_blf` the converged estimate ([`StateBuckling::blf`]) stops at the 2×2 split
-/// here: only [`crate::analysis::analyze`] refines further, and only the states that could
-/// govern (docs/convergence.md).
-pub fn state_buckling_mode(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode), DesignError> {
-    let options = AnalysisOptions {
-        blf_max_split: options.blf_max_split.min(2),
-        ..options.clone()
-    };
-    state_buckling_warm(state, material, &options, None).map(|(b, m, _)| (b, m))
-}
-
 /// Mode 1 of a state per shell node, keyed by (layer id, index of the node in its layer): keys
 /// that mean the same material point in every state, so one state's mode can start the
-/// eigensolver of the next ([`state_buckling_warm`]).
+/// eigensolver of the next ([`BucklingRequest::guess`]).
 pub type ModeGuess = HashMap<(i32, usize), [f64; 6]>;
 
 /// How far below a layer missing from a [`ModeGuess`] (a new top layer, or a row the previous
 /// mesh did not keep) its guess is looked up: the largest stride of a graded mesh is far less.
 const GUESS_REACH: i32 = 256;
 
-/// [`state_buckling_mode`] started from `guess` (the mode of a nearby state; `None`: a random
-/// start), also returning this state's mode as a [`ModeGuess`] for the next state. The guess
-/// only saves Lanczos steps: the result meets the same residual bound either way.
-pub fn state_buckling_warm(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-    guess: Option<&ModeGuess>,
-) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
-    let request = BucklingRequest {
-        guess,
-        ..Default::default()
-    };
-    state_buckling_with(state, material, options, &request).map(|r| (r.buckling, r.mode, r.next))
-}
-
-/// What a state's buckling solve ([`state_buckling_with`]) is asked beyond its factors; the
+/// What a state's buckling solve ([`state_buckling`]) is asked beyond its factors; the
 /// default: a cold start, nothing more.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct BucklingRequest<'a> {
@@ -173,7 +119,7 @@ pub struct BucklingRequest<'a> {
     pub bending: Option<Sections2D>,
 }
 
-/// What [`state_buckling_with`] gives.
+/// What [`state_buckling`] gives.
 #[derive(Debug, Clone)]
 pub struct StateSolve {
     /// The buckling analysis.
@@ -194,8 +140,13 @@ pub struct StateSolve {
     pub stresses: Option<(Vec<ElementStress>, Option<BendingSummary>)>,
 }
 
-/// [`state_buckling_warm`] and what `request` asks beyond it.
-pub fn state_buckling_with(
+/// Buckling analysis of one state (its shell model, [`state_shell`], under self-weight, solved by
+/// `kappe_fe`), and what `request` asks beyond it. With `converged_blf` the converged estimate
+/// ([`StateBuckling::blf`]) is refined up to `options.blf_max_split`: a single state solved
+/// outside [`crate::analysis::analyze`] stops at the 2×2 split
+/// ([`AnalysisOptions::with_split_at_most`]), [`crate::analysis::analyze`] refines further only
+/// the states that could govern (docs/convergence.md).
+pub fn state_buckling(
     state: &State,
     material: &ShellMaterial,
     options: &AnalysisOptions,
@@ -296,30 +247,25 @@ pub fn shell_buckling(
     shell: &StateShell,
     state: usize,
     options: &AnalysisOptions,
-) -> Result<StateBuckling, DesignError> {
-    shell_buckling_mode(shell, state, options).map(|(b, _)| b)
+) -> Result<ShellSolve, DesignError> {
+    shell_buckling_run(shell, state, options, None, &[]).map(|r| ShellSolve {
+        buckling: r.buckling,
+        mode: r.mode,
+        static_result: r.static_result,
+    })
 }
 
-/// [`shell_buckling`] and its first mode shape.
-pub fn shell_buckling_mode(
-    shell: &StateShell,
-    state: usize,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode), DesignError> {
-    shell_buckling_full(shell, state, options).map(|(b, mode, _)| (b, mode))
-}
-
-/// [`shell_buckling_mode`] and the linear static solution the buckling solve started from (None
-/// for a mechanism): the green-state strength checks read its membrane stresses, so they cost
-/// no second factorization (issue 11).
-#[allow(clippy::type_complexity)]
-pub fn shell_buckling_full(
-    shell: &StateShell,
-    state: usize,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode, Option<kappe_fe::StaticResult>), DesignError> {
-    shell_buckling_run(shell, state, options, None, &[])
-        .map(|r| (r.buckling, r.mode, r.static_result))
+/// What [`shell_buckling`] gives.
+#[derive(Debug, Clone)]
+pub struct ShellSolve {
+    /// The buckling analysis.
+    pub buckling: StateBuckling,
+    /// Mode 1 per network node.
+    pub mode: NetworkMode,
+    /// The linear static solution the buckling solve started from (`None` for a mechanism):
+    /// the green-state strength checks read its membrane stresses, so they cost no second
+    /// factorization (issue 11).
+    pub static_result: Option<kappe_fe::StaticResult>,
 }
 
 /// What [`shell_buckling_run`] returns.
@@ -515,7 +461,7 @@ fn guess_start(keys: &[Option<(i32, usize)>], g: &ModeGuess) -> Vec<[f64; 6]> {
 
 /// The mesh-error levels (`kappe_fe::converge_from`: the 2×2 split, and further up to
 /// `options.blf_max_split` while the error exceeds `blf_tolerance`) of a state whose
-/// print-layer mesh was already solved by [`state_buckling_warm`] with the same `material` and
+/// print-layer mesh was already solved by [`state_buckling`] with the same `material` and
 /// `options`: `coarse` is that solve's lowest factor and `mode` its mode 1 (the [`ModeGuess`] it
 /// returned), which starts the split's Lanczos. Solving the print-layer mesh again, from a cold
 /// start, cost the mesh-error pass about a sixth of its time (docs/convergence.md, "Speed").

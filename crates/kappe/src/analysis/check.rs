@@ -10,8 +10,8 @@ use serde::Serialize;
 use super::asprinted::Increment;
 use super::bending::BendingSummary;
 use super::buckling::{
-    BucklingRequest, BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_with,
-    state_material_with,
+    BucklingRequest, BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling,
+    state_material,
 };
 use super::stress::{
     STRESS_REL_TOL, StressExtremes, depth_invariant, element_stresses, extremes_by_depth,
@@ -350,77 +350,51 @@ pub fn fe_runs(options: &AnalysisOptions, total: usize) -> Vec<Vec<usize>> {
         .collect()
 }
 
+/// What [`state_fe`] is asked beyond the state; the default: no green-state model, nothing more.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FeRequest<'a> {
+    /// The green-state model: [`analysis_green`] of the run's schedule.
+    pub green: Option<&'a crate::analysis::green::CapGreen>,
+    /// Also what the buckling solve's factor of K gives beyond the factors: the state's
+    /// as-printed increment and a corrugated state's bending part ([`StateFeSolve`]).
+    pub extra: bool,
+}
+
+/// What [`state_fe`] gives.
+#[derive(Debug, Clone)]
+pub struct StateFeSolve {
+    /// The state's finite-element results.
+    pub fe: StateFe,
+    /// With [`FeRequest::extra`]: the as-printed increment, solved inside the buckling solve
+    /// (`None` where that solve cannot give it).
+    pub increment: Option<Increment>,
+    /// With [`FeRequest::extra`]: a corrugated state's stress extremes with its bending part,
+    /// solved inside the buckling solve (`None` where that solve cannot give them: phase 1 of
+    /// [`analyze`] solves them).
+    pub(crate) stresses: Option<(StressExtremes, Option<BendingSummary>)>,
+}
+
 /// The finite-element analysis of state `top` (shell buckling, and the green-state strength
-/// checks with a strength model): one step of a run of [`fe_runs`]. `guess` carries the warm
-/// start from the run's previous state (start each run with `None`); `green` is
-/// [`analysis_green`] of the run's schedule.
+/// checks with a strength model) with `options` as given: the first pass of [`analyze`] (one
+/// step of a run of [`fe_runs`]) passes `blf_max_split` 1
+/// ([`AnalysisOptions::with_split_at_most`]), the print-layer mesh alone, and estimates the mesh
+/// error over all states afterwards ([`converge_fe`]); more solves the split meshes too.
+/// `guess` carries the warm start from the run's previous state (start each run with `None`).
 ///
 /// # Errors
 /// A state that cannot be built or solved.
 pub fn state_fe(
     cap: &Cap,
     options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
     guess: &mut Option<ModeGuess>,
-) -> Result<StateFe, DesignError> {
-    state_fe_first(cap, options, green, top, guess, false).map(|f| f.fe)
-}
-
-/// What a state's first-pass solve ([`state_fe_first`]) gives beyond its [`StateFe`].
-struct FirstSolve {
-    fe: StateFe,
-    /// The as-printed increment, solved inside the buckling solve (`None` where that solve
-    /// cannot give it).
-    increment: Option<Increment>,
-    /// A corrugated state's stress extremes with its bending part, solved inside the buckling
-    /// solve (`None` where that solve cannot give them: phase 1 of [`assemble`] solves them).
-    stresses: Option<(StressExtremes, Option<BendingSummary>)>,
-}
-
-/// [`state_fe`] and, with `extra`, what the buckling solve's factor of K also gives: the
-/// state's as-printed increment and a corrugated state's bending part.
-fn state_fe_first(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-    extra: bool,
-) -> Result<FirstSolve, DesignError> {
-    // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
-    // all states together ([`converge_fe`]).
-    let first = AnalysisOptions {
-        blf_max_split: 1,
-        ..options.clone()
-    };
-    state_fe_printed(cap, &first, green, top, guess, extra)
-}
-
-/// [`state_fe`] with the options as given (`blf_max_split` > 1: the split meshes too).
-fn state_fe_with(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-) -> Result<StateFe, DesignError> {
-    state_fe_printed(cap, options, green, top, guess, false).map(|f| f.fe)
-}
-
-/// [`state_fe_with`] and, with `extra`, what [`state_fe_first`] gives beyond it.
-fn state_fe_printed(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-    extra: bool,
-) -> Result<FirstSolve, DesignError> {
+    request: &FeRequest<'_>,
+) -> Result<StateFeSolve, DesignError> {
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-    let mat = state_material_with(cap, options, top, green);
+    let green = request.green;
+    let mat = state_material(cap, options, top, green);
     // With a strength model the buckling solve's own static solution gives the membrane
     // stresses (one factorization per state, not two).
     let checked = match green {
@@ -432,11 +406,11 @@ fn state_fe_printed(
         _ => {
             let request = BucklingRequest {
                 guess: guess.as_ref(),
-                printed: extra,
+                printed: request.extra,
                 // Phase 1 of `assemble` adds the bending part to a corrugated cap's stresses.
-                bending: (extra && !cap.centre_arches.is_empty()).then(|| cap.areas()),
+                bending: (request.extra && !cap.centre_arches.is_empty()).then(|| cap.areas()),
             };
-            let r = state_buckling_with(&state, &mat, options, &request)?;
+            let r = state_buckling(&state, &mat, options, &request)?;
             *guess = Some(r.next);
             let stresses = r
                 .stresses
@@ -444,7 +418,7 @@ fn state_fe_printed(
             (r.buckling, r.mode, None, r.increment, stresses)
         }
     };
-    Ok(FirstSolve {
+    Ok(StateFeSolve {
         fe: StateFe {
             state: top,
             buckling,
@@ -458,7 +432,7 @@ fn state_fe_printed(
 }
 
 /// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
-/// ([`state_fe`] without a green-state model): [`state_fe_with`] with `options`, without
+/// ([`state_fe`] without a green-state model) with `options`, without
 /// solving the print-layer mesh again. Only `buckling.convergence` and `seconds` are meant to be
 /// read ([`converge_fe`]'s solver).
 ///
@@ -474,7 +448,7 @@ fn state_fe_refine(
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-    let mat = state_material_with(cap, options, top, None);
+    let mat = state_material(cap, options, top, None);
     let convergence = super::buckling::state_refine(&state, &mat, options, coarse, mode)?;
     Ok(StateFe {
         state: top,
@@ -604,7 +578,13 @@ pub fn solve_states(
 ) -> Result<Vec<StateFe>, DesignError> {
     states
         .iter()
-        .map(|&top| state_fe_with(cap, options, green, top, &mut None))
+        .map(|&top| {
+            let request = FeRequest {
+                green,
+                extra: false,
+            };
+            state_fe(cap, options, top, &mut None, &request).map(|r| r.fe)
+        })
         .collect()
 }
 
@@ -707,7 +687,7 @@ fn analyze_all(
     // together. With a graded mesh (issue 15) consecutive states share most of their mesh, so
     // each state's eigensolve starts from the previous state's mode: the selected states run in
     // contiguous runs, one after another within a run, the runs in parallel (largest first).
-    // The start changes the Lanczos steps, not the converged result (`state_buckling_warm`).
+    // The start changes the Lanczos steps, not the converged result (`BucklingRequest::guess`).
     // The green-state strength path (`CapGreen::state_checks`) starts cold.
     let t_phase = Instant::now();
     let runs = fe_runs(options, cap.states.len());
@@ -715,6 +695,9 @@ fn analyze_all(
     // Each state's first-pass mode is kept (about 50 bytes a shell node) so the mesh-error pass
     // continues from it instead of solving the print-layer mesh again (`state_refine`).
     let first_modes = std::sync::Mutex::new(std::collections::HashMap::new());
+    // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
+    // all states together (`converge_fe`).
+    let first = options.with_split_at_most(1);
     // Each state's as-printed increment, solved inside its buckling solve's factorization of K
     // (the as-printed pass then factorizes only the states this pass did not solve).
     let increments = std::sync::Mutex::new(std::collections::HashMap::new());
@@ -728,11 +711,15 @@ fn analyze_all(
             let mut out = Vec::with_capacity(run.len());
             for top in run {
                 cancelled()?;
-                let FirstSolve {
+                let request = FeRequest {
+                    green: green.as_ref(),
+                    extra: true,
+                };
+                let StateFeSolve {
                     fe: f,
                     increment,
                     stresses,
-                } = state_fe_first(cap, options, green.as_ref(), top, &mut guess, true)?;
+                } = state_fe(cap, &first, top, &mut guess, &request)?;
                 if let Some(i) = increment
                     && let Ok(mut m) = increments.lock()
                 {
@@ -775,7 +762,13 @@ fn analyze_all(
                     cancelled()?;
                     out.push(match first_modes.get(&top) {
                         Some((f1, mode)) => state_fe_refine(cap, opts, top, *f1, mode),
-                        None => state_fe_with(cap, opts, green.as_ref(), top, &mut None),
+                        None => {
+                            let request = FeRequest {
+                                green: green.as_ref(),
+                                extra: false,
+                            };
+                            state_fe(cap, opts, top, &mut None, &request).map(|r| r.fe)
+                        }
                     }?);
                 }
                 Ok(out)
@@ -883,7 +876,7 @@ fn assemble(
                     solved
                 } else {
                     // The bending part of the corrugation (`crate::analysis::bending`).
-                    let mat = crate::analysis::buckling::state_material_with(
+                    let mat = crate::analysis::buckling::state_material(
                         cap,
                         options,
                         top,

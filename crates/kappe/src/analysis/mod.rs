@@ -45,8 +45,8 @@ pub use crate::form::overhang::layer_overhangs;
 pub use crate::input::ageing::Ageing;
 pub use crate::input::analysis::{AnalysisOptions, SelectionError, StateSelection};
 pub use buckling::{
-    BucklingStatus, NetworkMode, StateBuckling, shell_buckling, shell_buckling_mode,
-    state_buckling, state_buckling_mode, state_material,
+    BucklingStatus, NetworkMode, ShellSolve, StateBuckling, shell_buckling, state_buckling,
+    state_material,
 };
 pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
 pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
@@ -55,10 +55,8 @@ pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
-pub use buckling::{
-    BucklingRequest, ModeGuess, StateSolve, state_buckling_warm, state_buckling_with, state_refine,
-};
-pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
+pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
+pub use check::{FeRequest, StateFe, StateFeSolve, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
