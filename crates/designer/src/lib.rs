@@ -470,14 +470,21 @@ impl WorkerCore {
         };
         self.guess = None;
         for &i in run {
+            // The first pass: the print-layer mesh alone (the mesh error is estimated over all
+            // states together when every worker is done).
+            let request = kappe::analysis::FeRequest {
+                green: self.green.as_ref(),
+                extra: false,
+            };
             let fe = state_fe(
                 cap,
-                &cap.design.analysis,
-                self.green.as_ref(),
+                &cap.design.analysis.with_split_at_most(1),
                 i,
                 &mut self.guess,
+                &request,
             )
-            .map_err(|e| FieldError::of(&e))?;
+            .map_err(|e| FieldError::of(&e))?
+            .fe;
             let wire = FeWire::from(&fe);
             on_state(serde_json::to_string(&[wire]).unwrap_or_default());
         }

@@ -11,8 +11,8 @@
 //!   modes, residuals and a Sturm-count proof that no lower factor was missed.
 //! * [`BucklingSolver`] caches the symbolic factorization for models with the same mesh and
 //!   supports (e.g. the ~100 print states of a vault);
-//!   [`BucklingSolver::buckling_with_weight_case`] also solves a second load case (part of the
-//!   self-weight) on the buckling solve's own factor of K.
+//!   [`BucklingSolver::buckling_with_cases`] also solves further load cases ([`LoadCase`]: part
+//!   of the self-weight, nodal loads) on the buckling solve's own factor of K.
 //! * [`element::ShellElement`] is the element boundary; [`element::cst_dkt::CstDkt`] the
 //!   reference element (default), [`element::andes_dkt::AndesDkt`] the ANDES/OPT membrane with
 //!   drilling freedoms + DKT, [`element::dkmt::AndesDkmt`] / [`element::dkmt::CstDkmt`] the
@@ -71,6 +71,6 @@ pub use nonlinear::{
     deformed_resultants, linearised_critical_factor, nonlinear_path, with_imperfection,
 };
 pub use solver::{
-    BucklingOptions, BucklingResult, BucklingSolver, ElementResult, SolveStats, StaticResult,
-    SturmCheck, buckling, linear_static,
+    BucklingOptions, BucklingResult, BucklingSolver, ElementResult, LoadCase, SolveStats,
+    StaticResult, SturmCheck, buckling, linear_static,
 };

@@ -26,7 +26,18 @@ use crate::assembly::{DofMap, Pattern, assemble, element_dofs, geometries, load_
 use crate::element::{Resultants, ShellElement, TriangleGeometry};
 use crate::error::{FeError, NodeDof};
 use crate::factor::{Llt, LltFailure, Symbolic};
-use crate::model::{ElementKind, ShellModel};
+use crate::model::{ElementKind, NodalLoad, ShellModel};
+
+/// A further load case of a buckling solve ([`BucklingSolver::buckling_with_cases`]), solved
+/// with its factor of K.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LoadCase {
+    /// Per triangle, whether its self-weight (`model.gravity`, its unit weight) is in the case;
+    /// empty: no self-weight.
+    pub weight: Vec<bool>,
+    /// The case's nodal loads (in place of the model's).
+    pub nodal_loads: Vec<NodalLoad>,
+}
 
 /// Results of a linear static analysis.
 #[derive(Debug, Clone, PartialEq)]
@@ -501,7 +512,7 @@ impl BucklingSolver {
         model: &ShellModel,
         options: &BucklingOptions,
     ) -> Result<BucklingResult, FeError> {
-        self.buckling_cases(model, options, None).map(|(r, _)| r)
+        self.buckling_cases(model, options, &[]).map(|(r, _)| r)
     }
 
     /// [`BucklingSolver::buckling`] and a second load case solved with the same factor of K:
@@ -512,33 +523,66 @@ impl BucklingSolver {
     /// whose static increment the as-printed shape sums (docs/as-printed.md).
     ///
     /// # Errors
-    /// As [`BucklingSolver::buckling`]; `weight` must have one entry per triangle.
+    /// As [`BucklingSolver::buckling_with_cases`].
     pub fn buckling_with_weight_case(
         &self,
         model: &ShellModel,
         options: &BucklingOptions,
         weight: &[bool],
     ) -> Result<(BucklingResult, StaticResult), FeError> {
-        if weight.len() != model.triangles.len() {
-            return Err(FeError::BadOption {
-                field: "weight (one entry per triangle)",
-                value: weight.len() as f64,
-                allowed: "as many entries as the model has triangles",
-            });
-        }
-        let (r, case) = self.buckling_cases(model, options, Some(weight))?;
-        case.map(|c| (r, c)).ok_or(FeError::Numerical {
+        let case = LoadCase {
+            weight: weight.to_vec(),
+            nodal_loads: model.nodal_loads.clone(),
+        };
+        let (r, mut cases) =
+            self.buckling_with_cases(model, options, std::slice::from_ref(&case))?;
+        cases.pop().map(|c| (r, c)).ok_or(FeError::Numerical {
             stage: "weight case",
             detail: "the second load case was not solved".into(),
         })
+    }
+
+    /// [`BucklingSolver::buckling`] and further load cases solved with the same factor of K,
+    /// one triangular solve each instead of a factorization: case `i`'s result is exactly
+    /// [`BucklingSolver::linear_static`] of `model` with the unit weight of the triangles not
+    /// in `cases[i].weight` set to zero and `cases[i].nodal_loads` for the model's (K depends
+    /// on neither). E.g. the weight a print state adds (docs/as-printed.md) and the unbalanced
+    /// forces a corrugated state's shell carries (docs/corrugation.md).
+    ///
+    /// # Errors
+    /// As [`BucklingSolver::buckling`]; a case's `weight` must have one entry per triangle (or
+    /// none), its nodal loads must name nodes of the model with finite values.
+    pub fn buckling_with_cases(
+        &self,
+        model: &ShellModel,
+        options: &BucklingOptions,
+        cases: &[LoadCase],
+    ) -> Result<(BucklingResult, Vec<StaticResult>), FeError> {
+        for c in cases {
+            if !c.weight.is_empty() && c.weight.len() != model.triangles.len() {
+                return Err(FeError::BadOption {
+                    field: "weight (one entry per triangle)",
+                    value: c.weight.len() as f64,
+                    allowed: "none, or as many entries as the model has triangles",
+                });
+            }
+        }
+        let (r, solved) = self.buckling_cases(model, options, cases)?;
+        if solved.len() != cases.len() {
+            return Err(FeError::Numerical {
+                stage: "load cases",
+                detail: "a load case was not solved".into(),
+            });
+        }
+        Ok((r, solved))
     }
 
     fn buckling_cases(
         &self,
         model: &ShellModel,
         options: &BucklingOptions,
-        weight: Option<&[bool]>,
-    ) -> Result<(BucklingResult, Option<StaticResult>), FeError> {
+        cases: &[LoadCase],
+    ) -> Result<(BucklingResult, Vec<StaticResult>), FeError> {
         self.check(model)?;
         if options.modes == 0 {
             return Err(FeError::BadOption {
@@ -567,23 +611,24 @@ impl BucklingSolver {
             kvals,
             geo,
         } = self.static_internal(model, &mut stats)?;
-        let case = match weight {
-            Some(w) => {
-                let mut only = model.clone();
-                only.materials = (0..model.triangles.len())
-                    .map(|e| {
-                        let mut m = model.material_of(e);
-                        if !w[e] {
-                            m.unit_weight = 0.0;
-                        }
-                        m
-                    })
-                    .collect();
-                let f = load_vector(&only, &geo);
-                Some(self.static_solve(&only, &llt, &f, &geo, &mut stats)?)
-            }
-            None => None,
-        };
+        let mut solved = Vec::with_capacity(cases.len());
+        for c in cases {
+            let mut only = model.clone();
+            only.materials = (0..model.triangles.len())
+                .map(|e| {
+                    let mut m = model.material_of(e);
+                    if !c.weight.get(e).copied().unwrap_or(false) {
+                        m.unit_weight = 0.0;
+                    }
+                    m
+                })
+                .collect();
+            only.nodal_loads.clone_from(&c.nodal_loads);
+            // The loads are validated as the model's own would be.
+            only.validate()?;
+            let f = load_vector(&only, &geo);
+            solved.push(self.static_solve(&only, &llt, &f, &geo, &mut stats)?);
+        }
         let t0 = Instant::now();
         let el = &*self.element;
         let elements = &static_result.elements;
@@ -722,7 +767,7 @@ impl BucklingSolver {
                 static_result,
                 stats,
             },
-            case,
+            solved,
         ))
     }
 

@@ -45,7 +45,7 @@ fn profile(file: &str, states: &[usize]) -> Result<(), Box<dyn std::error::Error
         };
         let t_graded = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let mat = state_material(&cap, &o, top)?;
+        let mat = state_material(&cap, &o, top, Some(&kappe::analysis::CapGreen::new(&cap)?));
         let Ok(shell) = kappe::analysis::state_shell(&reduced, &mat, o.row_stride) else {
             continue;
         };
@@ -168,7 +168,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..AnalysisOptions::default()
         };
         let t = Instant::now();
-        let b = state_buckling(&state, &state_material(&cap, &o, last)?, &o)?;
+        let b = state_buckling(
+            &state,
+            &state_material(&cap, &o, last, Some(&kappe::analysis::CapGreen::new(&cap)?)),
+            &o.with_split_at_most(2),
+            &Default::default(),
+        )?
+        .buckling;
         println!(
             "  stride {stride}: {:>5} nodes, BLF {:?}, {:.3} s (3 modes + Sturm check)",
             b.shell_nodes,
@@ -181,8 +187,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // factorization saves: states have different meshes, so kappe_fe::BucklingSolver can reuse
     // it only for models with the same mesh (e.g. another E or thickness of the same state).
     let o = AnalysisOptions::default();
-    let shell = kappe::analysis::state_shell(&state, &state_material(&cap, &o, last)?, 1)
-        .map_err(|e| format!("{e:?}"))?;
+    let shell = kappe::analysis::state_shell(
+        &state,
+        &state_material(&cap, &o, last, Some(&kappe::analysis::CapGreen::new(&cap)?)),
+        1,
+    )
+    .map_err(|e| format!("{e:?}"))?;
     let fe_opts = kappe_fe::BucklingOptions {
         modes: 1,
         tolerance: 1e-8,

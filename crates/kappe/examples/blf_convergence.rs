@@ -37,8 +37,17 @@ fn splits(
 ) -> Result<Vec<Level>, Box<dyn std::error::Error>> {
     let options = AnalysisOptions::default();
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top)?;
-    let shell = state_shell(&state, &state_material(cap, &options, top)?, 1)
-        .map_err(|e| format!("{e:?}"))?;
+    let shell = state_shell(
+        &state,
+        &state_material(
+            cap,
+            &options,
+            top,
+            Some(&kappe::analysis::CapGreen::new(cap)?),
+        ),
+        1,
+    )
+    .map_err(|e| format!("{e:?}"))?;
     let mut out = Vec::new();
     let mut n = 1;
     let opts = BucklingOptions {

@@ -59,8 +59,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             design.print.start_arch_fraction,
             top,
         )?;
-        let shell = state_shell(&state, &state_material(&cap, &options, top)?, 1)
-            .map_err(|e| format!("{e:?}"))?;
+        let shell = state_shell(
+            &state,
+            &state_material(
+                &cap,
+                &options,
+                top,
+                Some(&kappe::analysis::CapGreen::new(&cap)?),
+            ),
+            1,
+        )
+        .map_err(|e| format!("{e:?}"))?;
         let t = Instant::now();
         let cold = kappe_fe::buckling(&shell.model, &opts)?;
         row(top, "layer mesh, cold", &cold, t.elapsed().as_secs_f64());

@@ -37,8 +37,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             design.print.start_arch_fraction,
             top,
         )?;
-        let mut shell = state_shell(&state, &state_material(&cap, &options, top)?, 1)
-            .map_err(|e| format!("{e:?}"))?;
+        let mut shell = state_shell(
+            &state,
+            &state_material(
+                &cap,
+                &options,
+                top,
+                Some(&kappe::analysis::CapGreen::new(&cap)?),
+            ),
+            1,
+        )
+        .map_err(|e| format!("{e:?}"))?;
         shell.model.element = el;
         let mut prev: Option<f64> = None;
         for n in 1..=maxn {

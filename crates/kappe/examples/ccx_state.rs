@@ -89,8 +89,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             design.print.start_arch_fraction,
             top,
         )?;
-        let mut shell = state_shell(&state, &state_material(&cap, &options, top).unwrap(), 1)
-            .map_err(|e| format!("{e:?}"))?;
+        let mut shell = state_shell(
+            &state,
+            &state_material(
+                &cap,
+                &options,
+                top,
+                Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+            ),
+            1,
+        )
+        .map_err(|e| format!("{e:?}"))?;
         let n_split: usize = std::env::var("SPLIT")
             .ok()
             .and_then(|s| s.parse().ok())

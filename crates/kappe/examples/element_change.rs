@@ -39,7 +39,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|---|---|---|---|---|");
     for top in 0..cap.states.len() {
         let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-        let mat = state_material(&cap, &options, top).unwrap();
+        let mat = state_material(
+            &cap,
+            &options,
+            top,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        );
         let Ok(shell) = state_shell(&state, &mat, options.row_stride) else {
             println!("| {top} | {} | – | – | – | – |", state.top_layer);
             continue;

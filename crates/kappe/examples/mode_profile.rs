@@ -21,7 +21,17 @@ fn main() {
         .unwrap_or(total - 1);
     let opts = AnalysisOptions::default();
     let st = build_state(&cap.sections, &cap.frame, 0.0, top).unwrap();
-    let shell = state_shell(&st, &state_material(&cap, &opts, top).unwrap(), 1).unwrap();
+    let shell = state_shell(
+        &st,
+        &state_material(
+            &cap,
+            &opts,
+            top,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        ),
+        1,
+    )
+    .unwrap();
     let r = kappe_fe::buckling(
         &shell.model,
         &kappe_fe::BucklingOptions {

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::buckling::state_material_with;
+use crate::analysis::buckling::state_material;
 use crate::analysis::shell::{NoShell, StateShell, state_shell};
 use crate::form::cap::Cap;
 use crate::form::states::{Role, build_state};
@@ -209,7 +209,7 @@ pub fn cap_increment(
 ) -> Result<Increment, DesignError> {
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-    let mat = state_material_with(cap, options, top, green);
+    let mat = state_material(cap, options, top, green);
     let shell = match state_shell(&state, &mat, 1) {
         Ok(s) => s,
         // A single layer lies on the bed: every node is supported, nothing moves.

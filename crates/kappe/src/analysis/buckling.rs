@@ -7,8 +7,11 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::analysis::asprinted::Increment;
+use crate::analysis::bending::BendingSummary;
 use crate::analysis::shell::{NoShell, ShellMaterial, StateShell, state_shell};
+use crate::analysis::stress::ElementStress;
 use crate::form::cap::Cap;
+use crate::form::forces::Sections2D;
 use crate::form::states::State;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
@@ -32,22 +35,10 @@ pub enum BucklingStatus {
 }
 
 /// The shell material of the state with top print index `top`: the design's material, every
-/// layer's modulus from its age on the cap's schedule when the time model varies with age.
-///
-/// # Errors
-/// An invalid time model or a `[schedule]` that does not fit the print.
+/// layer's modulus from its age on `green`'s schedule (the run's one clock, e.g. the robot
+/// plan's; [`crate::analysis::green::CapGreen::new`]: the cap's own) when the time model varies
+/// with age; `None`: the material without a time model.
 pub fn state_material(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    top: usize,
-) -> Result<ShellMaterial, DesignError> {
-    let green = crate::analysis::green::CapGreen::new(cap)?;
-    Ok(state_material_with(cap, options, top, Some(&green)))
-}
-
-/// [`state_material`] with the layers' ages from `green`'s schedule (the run's one clock, e.g.
-/// the robot plan's); `None`: the material without a time model.
-pub fn state_material_with(
     cap: &Cap,
     options: &AnalysisOptions,
     top: usize,
@@ -103,74 +94,72 @@ impl StateBuckling {
 /// the report draws. Empty when the state has no mode.
 pub type NetworkMode = Vec<(usize, [f64; 3])>;
 
-/// Buckling analysis of one state (shell model + `kappe_fe::buckling`).
-pub fn state_buckling(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-) -> Result<StateBuckling, DesignError> {
-    state_buckling_mode(state, material, options).map(|(b, _)| b)
-}
-
-/// [`state_buckling`] and its first mode shape.
-///
-/// With `converged_blf` the converged estimate ([`StateBuckling::blf`]) stops at the 2×2 split
-/// here: only [`crate::analysis::analyze`] refines further, and only the states that could
-/// govern (docs/convergence.md).
-pub fn state_buckling_mode(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode), DesignError> {
-    let options = AnalysisOptions {
-        blf_max_split: options.blf_max_split.min(2),
-        ..options.clone()
-    };
-    state_buckling_warm(state, material, &options, None).map(|(b, m, _)| (b, m))
-}
-
 /// Mode 1 of a state per shell node, keyed by (layer id, index of the node in its layer): keys
 /// that mean the same material point in every state, so one state's mode can start the
-/// eigensolver of the next ([`state_buckling_warm`]).
+/// eigensolver of the next ([`BucklingRequest::guess`]).
 pub type ModeGuess = HashMap<(i32, usize), [f64; 6]>;
 
 /// How far below a layer missing from a [`ModeGuess`] (a new top layer, or a row the previous
 /// mesh did not keep) its guess is looked up: the largest stride of a graded mesh is far less.
 const GUESS_REACH: i32 = 256;
 
-/// [`state_buckling_mode`] started from `guess` (the mode of a nearby state; `None`: a random
-/// start), also returning this state's mode as a [`ModeGuess`] for the next state. The guess
-/// only saves Lanczos steps: the result meets the same residual bound either way.
-pub fn state_buckling_warm(
-    state: &State,
-    material: &ShellMaterial,
-    options: &AnalysisOptions,
-    guess: Option<&ModeGuess>,
-) -> Result<(StateBuckling, NetworkMode, ModeGuess), DesignError> {
-    state_buckling_printed(state, material, options, guess, false).map(|(b, m, g, _)| (b, m, g))
+/// What a state's buckling solve ([`state_buckling`]) is asked beyond its factors; the
+/// default: a cold start, nothing more.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BucklingRequest<'a> {
+    /// Start the eigensolver from this mode of a nearby state (`None`: a random start). It only
+    /// saves Lanczos steps: the result meets the same residual bound either way.
+    pub guess: Option<&'a ModeGuess>,
+    /// Also the state's as-printed increment (the weight of its new strip alone), on a mesh the
+    /// as-printed pass shares ([`crate::analysis::asprinted::shares_mesh`]).
+    pub printed: bool,
+    /// Also the element stresses with a corrugated state's bending part, for these section
+    /// areas ([`crate::analysis::bending`]), on a mesh the bending part shares (the state's
+    /// own, row stride 1, no grading).
+    pub bending: Option<Sections2D>,
 }
 
-/// [`state_buckling_warm`] and, with `printed` on a mesh the as-printed pass shares
-/// ([`crate::analysis::asprinted::shares_mesh`]), the state's as-printed increment (the weight
-/// of its new strip alone) solved with the buckling solve's own factor of K: exactly
-/// [`crate::analysis::asprinted::cap_increment`]'s, for one triangular solve instead of a
-/// second factorization. `None` without `printed`, on a mesh the pass does not share, for a
-/// single layer or a mechanism.
-pub fn state_buckling_printed(
+/// What [`state_buckling`] gives.
+#[derive(Debug, Clone)]
+pub struct StateSolve {
+    /// The buckling analysis.
+    pub buckling: StateBuckling,
+    /// Mode 1 per network node.
+    pub mode: NetworkMode,
+    /// Mode 1 as a [`ModeGuess`] for the next state (empty when none).
+    pub next: ModeGuess,
+    /// With [`BucklingRequest::printed`]: the as-printed increment, solved with the buckling
+    /// solve's own factor of K (exactly [`crate::analysis::asprinted::cap_increment`]'s, for one
+    /// triangular solve instead of a second factorization). `None` on a mesh the pass does not
+    /// share, for a single layer or a mechanism.
+    pub increment: Option<Increment>,
+    /// With [`BucklingRequest::bending`]: the element stresses and the bending summary,
+    /// exactly [`crate::analysis::bending::corrugated_stresses`]'s (its shell statics solved as
+    /// a load case on the buckling solve's factor). `None` where that solve cannot give them
+    /// (another mesh, a single layer, a mechanism) or the state has no unbalanced forces.
+    pub stresses: Option<(Vec<ElementStress>, Option<BendingSummary>)>,
+}
+
+/// Buckling analysis of one state (its shell model, [`state_shell`], under self-weight, solved by
+/// `kappe_fe`), and what `request` asks beyond it. With `converged_blf` the converged estimate
+/// ([`StateBuckling::blf`]) is refined up to `options.blf_max_split`: a single state solved
+/// outside [`crate::analysis::analyze`] stops at the 2×2 split
+/// ([`AnalysisOptions::with_split_at_most`]), [`crate::analysis::analyze`] refines further only
+/// the states that could govern (docs/convergence.md).
+pub fn state_buckling(
     state: &State,
     material: &ShellMaterial,
     options: &AnalysisOptions,
-    guess: Option<&ModeGuess>,
-    printed: bool,
-) -> Result<(StateBuckling, NetworkMode, ModeGuess, Option<Increment>), DesignError> {
+    request: &BucklingRequest<'_>,
+) -> Result<StateSolve, DesignError> {
     // A graded mesh (issue 15, `crate::analysis::graded`) analyses the state reduced to its kept rows; the
     // mode is mapped back to the state's own network nodes.
     let analysed = crate::analysis::graded::AnalysedState::new(state, options.grading.as_ref());
     let shell = match state_shell(analysed.state(), material, options.row_stride) {
         Ok(s) => s,
         Err(NoShell::SingleLayer) => {
-            return Ok((
-                StateBuckling {
+            return Ok(StateSolve {
+                buckling: StateBuckling {
                     status: BucklingStatus::SingleLayer,
                     factors: Vec::new(),
                     location: None,
@@ -178,35 +167,59 @@ pub fn state_buckling_printed(
                     shell_nodes: 0,
                     convergence: None,
                 },
-                Vec::new(),
-                ModeGuess::new(),
-                None,
-            ));
+                mode: Vec::new(),
+                next: ModeGuess::new(),
+                increment: None,
+                stresses: None,
+            });
         }
     };
     let keys = guess_keys(state, &analysed, &shell);
-    let start = guess
+    let start = request
+        .guess
         .filter(|g| !g.is_empty())
         .map(|g| guess_start(&keys, g));
+    let own_mesh = crate::analysis::asprinted::shares_mesh(options);
+    let mut cases = Vec::new();
     // The as-printed increment's load: the strip that ends in the new top layer
     // (`asprinted::cap_increment`).
-    let new_strip: Option<Vec<bool>> =
-        (printed && crate::analysis::asprinted::shares_mesh(options)).then(|| {
-            shell
+    let printed = request.printed && own_mesh;
+    if printed {
+        cases.push(kappe_fe::LoadCase {
+            weight: shell
                 .element_layers
                 .iter()
                 .map(|l| l.1 == state.top_layer)
-                .collect()
+                .collect(),
+            nodal_loads: shell.model.nodal_loads.clone(),
         });
+    }
+    // The corrugation's bending part: the unbalanced forces on the same shell.
+    let unbalanced = match request.bending {
+        Some(areas) if own_mesh => {
+            let u = crate::analysis::bending::Unbalanced::of(state, areas)?;
+            u.any().then_some(u)
+        }
+        _ => None,
+    };
+    let bending_case = unbalanced.as_ref().map(|u| u.load_case(&shell));
+    cases.extend(bending_case.iter().cloned());
     let Run {
         buckling: b,
         mode,
         full,
-        case,
+        cases: solved,
         ..
-    } = shell_buckling_run(&shell, state.index, options, start, new_strip.as_deref())?;
-    let increment =
-        case.map(|r| crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r));
+    } = shell_buckling_run(&shell, state.index, options, start, &cases)?;
+    let mut solved = solved.into_iter();
+    let increment = printed
+        .then(|| solved.next())
+        .flatten()
+        .map(|r| crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r));
+    let stresses = match (unbalanced, bending_case, solved.next()) {
+        (Some(u), Some(case), Some(st)) => Some(u.stresses(state, &shell, &case, &st)),
+        _ => None,
+    };
     let mode = mode
         .into_iter()
         .map(|(k, d)| (analysed.full_index(k).unwrap_or(k), d))
@@ -219,7 +232,13 @@ pub fn state_buckling_printed(
                 .collect()
         })
         .unwrap_or_default();
-    Ok((b, mode, next, increment))
+    Ok(StateSolve {
+        buckling: b,
+        mode,
+        next,
+        increment,
+        stresses,
+    })
 }
 
 /// Buckling analysis of a shell model built by [`state_shell`] (`state` names the state in
@@ -228,30 +247,25 @@ pub fn shell_buckling(
     shell: &StateShell,
     state: usize,
     options: &AnalysisOptions,
-) -> Result<StateBuckling, DesignError> {
-    shell_buckling_mode(shell, state, options).map(|(b, _)| b)
+) -> Result<ShellSolve, DesignError> {
+    shell_buckling_run(shell, state, options, None, &[]).map(|r| ShellSolve {
+        buckling: r.buckling,
+        mode: r.mode,
+        static_result: r.static_result,
+    })
 }
 
-/// [`shell_buckling`] and its first mode shape.
-pub fn shell_buckling_mode(
-    shell: &StateShell,
-    state: usize,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode), DesignError> {
-    shell_buckling_full(shell, state, options).map(|(b, mode, _)| (b, mode))
-}
-
-/// [`shell_buckling_mode`] and the linear static solution the buckling solve started from (None
-/// for a mechanism): the green-state strength checks read its membrane stresses, so they cost
-/// no second factorization (issue 11).
-#[allow(clippy::type_complexity)]
-pub fn shell_buckling_full(
-    shell: &StateShell,
-    state: usize,
-    options: &AnalysisOptions,
-) -> Result<(StateBuckling, NetworkMode, Option<kappe_fe::StaticResult>), DesignError> {
-    shell_buckling_run(shell, state, options, None, None)
-        .map(|r| (r.buckling, r.mode, r.static_result))
+/// What [`shell_buckling`] gives.
+#[derive(Debug, Clone)]
+pub struct ShellSolve {
+    /// The buckling analysis.
+    pub buckling: StateBuckling,
+    /// Mode 1 per network node.
+    pub mode: NetworkMode,
+    /// The linear static solution the buckling solve started from (`None` for a mechanism):
+    /// the green-state strength checks read its membrane stresses, so they cost no second
+    /// factorization (issue 11).
+    pub static_result: Option<kappe_fe::StaticResult>,
 }
 
 /// What [`shell_buckling_run`] returns.
@@ -262,30 +276,30 @@ struct Run {
     full: Option<Vec<[f64; 6]>>,
     /// The static solution the buckling solve started from (None for a mechanism).
     static_result: Option<kappe_fe::StaticResult>,
-    /// The second load case (the `weight` triangles' self-weight alone), if asked for.
-    case: Option<kappe_fe::StaticResult>,
+    /// The further load cases' static solutions, in order (empty for a mechanism).
+    cases: Vec<kappe_fe::StaticResult>,
 }
 
 /// One buckling solve of a shell model, started from `start` (per shell node) if given; also
-/// returns mode 1 with all six freedoms per shell node and, with `weight` (per triangle), the
-/// static solution under those triangles' self-weight alone, on the same factor of K.
+/// returns mode 1 with all six freedoms per shell node and the static solutions of `cases` on
+/// the same factor of K.
 fn shell_buckling_run(
     shell: &StateShell,
     state: usize,
     options: &AnalysisOptions,
     start: Option<Vec<[f64; 6]>>,
-    weight: Option<&[bool]>,
+    cases: &[kappe_fe::LoadCase],
 ) -> Result<Run, DesignError> {
     let fe_opts = fe_options(options, start);
     let n = shell.model.nodes.len();
-    let solved = match weight {
-        Some(w) => kappe_fe::BucklingSolver::new(&shell.model)
-            .and_then(|s| s.buckling_with_weight_case(&shell.model, &fe_opts, w))
-            .map(|(r, c)| (r, Some(c))),
-        None => kappe_fe::buckling(&shell.model, &fe_opts).map(|r| (r, None)),
+    let solved = if cases.is_empty() {
+        kappe_fe::buckling(&shell.model, &fe_opts).map(|r| (r, Vec::new()))
+    } else {
+        kappe_fe::BucklingSolver::new(&shell.model)
+            .and_then(|s| s.buckling_with_cases(&shell.model, &fe_opts, cases))
     };
     match solved {
-        Ok((r, case)) => {
+        Ok((r, solved_cases)) => {
             let static_result = Some(r.static_result.clone());
             let location = r.modes.first().and_then(|m| {
                 let (i, _) = m
@@ -338,7 +352,7 @@ fn shell_buckling_run(
                 mode,
                 full,
                 static_result,
-                case,
+                cases: solved_cases,
             })
         }
         Err(kappe_fe::FeError::Mechanism { free_dofs }) => {
@@ -370,7 +384,7 @@ fn shell_buckling_run(
                 mode: Vec::new(),
                 full: None,
                 static_result: None,
-                case: None,
+                cases: Vec::new(),
             })
         }
         Err(e) => Err(DesignError::State {
@@ -447,7 +461,7 @@ fn guess_start(keys: &[Option<(i32, usize)>], g: &ModeGuess) -> Vec<[f64; 6]> {
 
 /// The mesh-error levels (`kappe_fe::converge_from`: the 2×2 split, and further up to
 /// `options.blf_max_split` while the error exceeds `blf_tolerance`) of a state whose
-/// print-layer mesh was already solved by [`state_buckling_warm`] with the same `material` and
+/// print-layer mesh was already solved by [`state_buckling`] with the same `material` and
 /// `options`: `coarse` is that solve's lowest factor and `mode` its mode 1 (the [`ModeGuess`] it
 /// returned), which starts the split's Lanczos. Solving the print-layer mesh again, from a cold
 /// start, cost the mesh-error pass about a sixth of its time (docs/convergence.md, "Speed").

@@ -8,9 +8,10 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use super::asprinted::Increment;
+use super::bending::BendingSummary;
 use super::buckling::{
-    BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling_printed,
-    state_material_with,
+    BucklingRequest, BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling,
+    state_material,
 };
 use super::stress::{STRESS_REL_TOL, StressExtremes};
 use crate::form::cap::Cap;
@@ -347,83 +348,76 @@ pub fn fe_runs(options: &AnalysisOptions, total: usize) -> Vec<Vec<usize>> {
         .collect()
 }
 
+/// What [`state_fe`] is asked beyond the state; the default: no green-state model, nothing more.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FeRequest<'a> {
+    /// The green-state model: [`analysis_green`] of the run's schedule.
+    pub green: Option<&'a crate::analysis::green::CapGreen>,
+    /// Also what the buckling solve's factor of K gives beyond the factors: the state's
+    /// as-printed increment and a corrugated state's bending part ([`StateFeSolve`]).
+    pub extra: bool,
+}
+
+/// What [`state_fe`] gives.
+#[derive(Debug, Clone)]
+pub struct StateFeSolve {
+    /// The state's finite-element results.
+    pub fe: StateFe,
+    /// With [`FeRequest::extra`]: the as-printed increment, solved inside the buckling solve
+    /// (`None` where that solve cannot give it).
+    pub increment: Option<Increment>,
+    /// With [`FeRequest::extra`]: a corrugated state's stress extremes with its bending part,
+    /// solved inside the buckling solve (`None` where that solve cannot give them: phase 1 of
+    /// [`analyze`] solves them).
+    pub(crate) stresses: Option<(StressExtremes, Option<BendingSummary>)>,
+}
+
 /// The finite-element analysis of state `top` (shell buckling, and the green-state strength
-/// checks with a strength model): one step of a run of [`fe_runs`]. `guess` carries the warm
-/// start from the run's previous state (start each run with `None`); `green` is
-/// [`analysis_green`] of the run's schedule.
+/// checks with a strength model) with `options` as given: the first pass of [`analyze`] (one
+/// step of a run of [`fe_runs`]) passes `blf_max_split` 1
+/// ([`AnalysisOptions::with_split_at_most`]), the print-layer mesh alone, and estimates the mesh
+/// error over all states afterwards ([`converge_fe`]); more solves the split meshes too.
+/// `guess` carries the warm start from the run's previous state (start each run with `None`).
 ///
 /// # Errors
 /// A state that cannot be built or solved.
 pub fn state_fe(
     cap: &Cap,
     options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
     guess: &mut Option<ModeGuess>,
-) -> Result<StateFe, DesignError> {
-    state_fe_first(cap, options, green, top, guess, false).map(|(f, _)| f)
-}
-
-/// [`state_fe`] and, with `printed`, the state's as-printed increment solved inside its
-/// buckling solve (`state_buckling_printed`; `None` where that solve cannot give it).
-fn state_fe_first(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-    printed: bool,
-) -> Result<(StateFe, Option<Increment>), DesignError> {
-    // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
-    // all states together ([`converge_fe`]).
-    let first = AnalysisOptions {
-        blf_max_split: 1,
-        ..options.clone()
-    };
-    state_fe_printed(cap, &first, green, top, guess, printed)
-}
-
-/// [`state_fe`] with the options as given (`blf_max_split` > 1: the split meshes too).
-fn state_fe_with(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-) -> Result<StateFe, DesignError> {
-    state_fe_printed(cap, options, green, top, guess, false).map(|(f, _)| f)
-}
-
-/// [`state_fe_with`] and, with `printed`, the as-printed increment of [`state_fe_first`].
-fn state_fe_printed(
-    cap: &Cap,
-    options: &AnalysisOptions,
-    green: Option<&crate::analysis::green::CapGreen>,
-    top: usize,
-    guess: &mut Option<ModeGuess>,
-    printed: bool,
-) -> Result<(StateFe, Option<Increment>), DesignError> {
+    request: &FeRequest<'_>,
+) -> Result<StateFeSolve, DesignError> {
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-    let mat = state_material_with(cap, options, top, green);
+    let green = request.green;
+    let mat = state_material(cap, options, top, green);
     // With a strength model the buckling solve's own static solution gives the membrane
     // stresses (one factorization per state, not two).
     let checked = match green {
         Some(g) => g.state_checks(&state, &mat, options, top)?,
         None => None,
     };
-    let (buckling, mode, green, increment) = match checked {
-        Some((b, mode, green)) => (b, mode, green, None),
+    let (buckling, mode, green, increment, stresses) = match checked {
+        Some((b, mode, green)) => (b, mode, green, None, None),
         _ => {
-            let (b, mode, next, increment) =
-                state_buckling_printed(&state, &mat, options, guess.as_ref(), printed)?;
-            *guess = Some(next);
-            (b, mode, None, increment)
+            let request = BucklingRequest {
+                guess: guess.as_ref(),
+                printed: request.extra,
+                // Phase 1 of `assemble` adds the bending part to a corrugated cap's stresses.
+                bending: (request.extra && !cap.centre_arches.is_empty()).then(|| cap.areas()),
+            };
+            let r = state_buckling(&state, &mat, options, &request)?;
+            *guess = Some(r.next);
+            let stresses = r
+                .stresses
+                .map(|(all, bending)| (StressExtremes::of(&all), bending));
+            (r.buckling, r.mode, None, r.increment, stresses)
         }
     };
-    Ok((
-        StateFe {
+    Ok(StateFeSolve {
+        fe: StateFe {
             state: top,
             buckling,
             mode,
@@ -431,11 +425,12 @@ fn state_fe_printed(
             seconds: t0.elapsed().as_secs_f64(),
         },
         increment,
-    ))
+        stresses,
+    })
 }
 
 /// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
-/// ([`state_fe`] without a green-state model): [`state_fe_with`] with `options`, without
+/// ([`state_fe`] without a green-state model) with `options`, without
 /// solving the print-layer mesh again. Only `buckling.convergence` and `seconds` are meant to be
 /// read ([`converge_fe`]'s solver).
 ///
@@ -451,7 +446,7 @@ fn state_fe_refine(
     let t0 = Instant::now();
     let phi = cap.design.print.start_arch_fraction;
     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-    let mat = state_material_with(cap, options, top, None);
+    let mat = state_material(cap, options, top, None);
     let convergence = super::buckling::state_refine(&state, &mat, options, coarse, mode)?;
     Ok(StateFe {
         state: top,
@@ -581,7 +576,13 @@ pub fn solve_states(
 ) -> Result<Vec<StateFe>, DesignError> {
     states
         .iter()
-        .map(|&top| state_fe_with(cap, options, green, top, &mut None))
+        .map(|&top| {
+            let request = FeRequest {
+                green,
+                extra: false,
+            };
+            state_fe(cap, options, top, &mut None, &request).map(|r| r.fe)
+        })
         .collect()
 }
 
@@ -654,6 +655,7 @@ fn analyze_from_fe(
         (t_all, 0.0),
         complete,
         Default::default(),
+        Default::default(),
         context.stop_flag(),
     )
 }
@@ -683,7 +685,7 @@ fn analyze_all(
     // together. With a graded mesh (issue 15) consecutive states share most of their mesh, so
     // each state's eigensolve starts from the previous state's mode: the selected states run in
     // contiguous runs, one after another within a run, the runs in parallel (largest first).
-    // The start changes the Lanczos steps, not the converged result (`state_buckling_warm`).
+    // The start changes the Lanczos steps, not the converged result (`BucklingRequest::guess`).
     // The green-state strength path (`CapGreen::state_checks`) starts cold.
     let t_phase = Instant::now();
     let runs = fe_runs(options, cap.states.len());
@@ -691,9 +693,15 @@ fn analyze_all(
     // Each state's first-pass mode is kept (about 50 bytes a shell node) so the mesh-error pass
     // continues from it instead of solving the print-layer mesh again (`state_refine`).
     let first_modes = std::sync::Mutex::new(std::collections::HashMap::new());
+    // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
+    // all states together (`converge_fe`).
+    let first = options.with_split_at_most(1);
     // Each state's as-printed increment, solved inside its buckling solve's factorization of K
     // (the as-printed pass then factorizes only the states this pass did not solve).
     let increments = std::sync::Mutex::new(std::collections::HashMap::new());
+    // A corrugated state's stresses with its bending part, likewise (phase 1 of `assemble`
+    // then solves only the states this pass did not).
+    let bending = std::sync::Mutex::new(std::collections::HashMap::new());
     let fe: Vec<StateFe> = runs
         .into_par_iter()
         .map(|run| {
@@ -701,12 +709,24 @@ fn analyze_all(
             let mut out = Vec::with_capacity(run.len());
             for top in run {
                 cancelled()?;
-                let (f, increment) =
-                    state_fe_first(cap, options, green.as_ref(), top, &mut guess, true)?;
+                let request = FeRequest {
+                    green: green.as_ref(),
+                    extra: true,
+                };
+                let StateFeSolve {
+                    fe: f,
+                    increment,
+                    stresses,
+                } = state_fe(cap, &first, top, &mut guess, &request)?;
                 if let Some(i) = increment
                     && let Ok(mut m) = increments.lock()
                 {
                     m.insert(top, i);
+                }
+                if let Some(x) = stresses
+                    && let Ok(mut m) = bending.lock()
+                {
+                    m.insert(top, x);
                 }
                 if let (None, Some(g), Some(&f1)) = (&green, &guess, f.buckling.factors.first())
                     && let Ok(mut m) = first_modes.lock()
@@ -740,7 +760,13 @@ fn analyze_all(
                     cancelled()?;
                     out.push(match first_modes.get(&top) {
                         Some((f1, mode)) => state_fe_refine(cap, opts, top, *f1, mode),
-                        None => state_fe_with(cap, opts, green.as_ref(), top, &mut None),
+                        None => {
+                            let request = FeRequest {
+                                green: green.as_ref(),
+                                extra: false,
+                            };
+                            state_fe(cap, opts, top, &mut None, &request).map(|r| r.fe)
+                        }
                     }?);
                 }
                 Ok(out)
@@ -758,6 +784,7 @@ fn analyze_all(
         (t_all, wall_fe),
         true,
         increments.into_inner().unwrap_or_default(),
+        bending.into_inner().unwrap_or_default(),
         stop,
     )
 }
@@ -767,7 +794,8 @@ fn analyze_all(
 /// seconds of the finite-element phase. `complete`: every selected state is in `fe`, so the
 /// whole-print passes run (the as-printed shape; a partial verdict, the designer's while its
 /// workers run, leaves them out rather than pay for them at every result). `increments`: the
-/// as-printed increments the buckling solves already gave (by state; the pass solves the rest).
+/// as-printed increments the buckling solves already gave (by state; the pass solves the rest);
+/// `solved_bending`: likewise a corrugated cap's stresses with their bending part.
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     cap: &Cap,
@@ -778,6 +806,7 @@ fn assemble(
     (t_all, wall_fe): (Instant, f64),
     complete: bool,
     increments: std::collections::HashMap<usize, Increment>,
+    solved_bending: std::collections::HashMap<usize, (StressExtremes, Option<BendingSummary>)>,
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     let cancelled = || {
@@ -793,7 +822,7 @@ fn assemble(
     let phi = design.print.start_arch_fraction;
 
     struct PerState {
-        bending: Option<crate::analysis::bending::BendingSummary>,
+        bending: Option<BendingSummary>,
         stresses: StressExtremes,
         stress_seconds: f64,
         buckling: Option<StateBuckling>,
@@ -812,11 +841,18 @@ fn assemble(
             cancelled()?;
             let t0 = Instant::now();
             let summary = cap.states.get(top);
-            let (stresses, bending) = match summary.and_then(|s| s.stresses) {
-                Some(stresses) => (stresses, None),
+            // A corrugated state's bending may have been solved as a load case of its buckling
+            // solve already.
+            let known = summary
+                .and_then(|s| s.stresses)
+                .map(|s| (s, None))
+                .or_else(|| solved_bending.get(&top).copied());
+            let (stresses, bending) = match known {
+                Some(known) => known,
                 None => {
                     let state = build_state(&cap.sections, &cap.frame, phi, top)?;
-                    let mat = crate::analysis::buckling::state_material_with(
+                    // The bending part of the corrugation (`crate::analysis::bending`).
+                    let mat = crate::analysis::buckling::state_material(
                         cap,
                         options,
                         top,

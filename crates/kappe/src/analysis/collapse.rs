@@ -468,7 +468,7 @@ pub fn cap_state_lba(
         cap.design.print.start_arch_fraction,
         top,
     )?;
-    let mat = crate::analysis::buckling::state_material_with(cap, options, top, green);
+    let mat = crate::analysis::buckling::state_material(cap, options, top, green);
     let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
         return Ok(None);
     };

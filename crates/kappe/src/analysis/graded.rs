@@ -28,7 +28,7 @@
 //! Rows are anchored at print index 0 (a row is kept when its index is a multiple of its stride),
 //! so the mesh of a state is the previous state's mesh less a few rows plus the new top layer:
 //! [`crate::analysis::analyze`] starts each state's Lanczos iteration from the previous state's
-//! mode ([`crate::analysis::buckling::state_buckling_warm`]), about 30 % fewer CPU seconds.
+//! mode ([`crate::analysis::buckling::BucklingRequest::guess`]), about 30 % fewer CPU seconds.
 //! (`kappe_fe` blends the start with seeded noise: the previous mode alone once made a 4.8 m
 //! cap's state converge to its second mode, 2 % high.)
 //!

@@ -515,8 +515,11 @@ impl CapGreen {
         else {
             return Ok(None);
         };
-        let (b, mut mode, st) =
-            crate::analysis::buckling::shell_buckling_full(&shell, state.index, options)?;
+        let crate::analysis::buckling::ShellSolve {
+            buckling: b,
+            mut mode,
+            static_result: st,
+        } = crate::analysis::buckling::shell_buckling(&shell, state.index, options)?;
         for (k, _) in &mut mode {
             *k = analysed.full_index(*k).unwrap_or(*k);
         }

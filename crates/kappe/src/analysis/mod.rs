@@ -49,8 +49,8 @@ pub use crate::form::stresses::{ElementKind, ElementStress, STRESS_REL_TOL, elem
 pub use crate::input::ageing::Ageing;
 pub use crate::input::analysis::{AnalysisOptions, SelectionError, StateSelection};
 pub use buckling::{
-    BucklingStatus, NetworkMode, StateBuckling, shell_buckling, shell_buckling_mode,
-    state_buckling, state_buckling_mode, state_material,
+    BucklingStatus, NetworkMode, ShellSolve, StateBuckling, shell_buckling, state_buckling,
+    state_material,
 };
 pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
 
@@ -58,8 +58,8 @@ pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, ana
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf};
-pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
-pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
+pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
+pub use check::{FeRequest, StateFe, StateFeSolve, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{
     CURVE_POINTS, CollapseMode, StateLba, cap_as_printed_shift, cap_state_collapse, cap_state_lba,
     object_as_printed_shift, shifted,

@@ -33,7 +33,7 @@ use kappe_reliability::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::buckling::{state_buckling, state_material_with};
+use super::buckling::{state_buckling, state_material};
 use super::check::Analysis;
 use crate::form::cap::Cap;
 use crate::form::states::build_state;
@@ -406,11 +406,17 @@ pub fn checks_of(
                 (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
             let phi = cap.design.print.start_arch_fraction;
             let state = build_state(&cap.sections, &cap.frame, phi, s.index)?;
-            let mut mat = state_material_with(cap, options, s.index, green.as_ref());
+            let mut mat = state_material(cap, options, s.index, green.as_ref());
             let mut f = [0.0; 2];
             for (k, sign) in [1.0, -1.0].into_iter().enumerate() {
                 mat.poisson_ratio = v.nu0 + sign * NU_STEP;
-                let b = state_buckling(&state, &mat, options)?;
+                let b = state_buckling(
+                    &state,
+                    &mat,
+                    &options.with_split_at_most(2),
+                    &Default::default(),
+                )?
+                .buckling;
                 f[k] = b.factors.first().copied().unwrap_or(blf);
             }
             (f[0] - f[1]) / (2.0 * NU_STEP) / blf

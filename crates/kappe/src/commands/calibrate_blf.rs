@@ -168,7 +168,19 @@ fn state_blfs(
         .filter(|&&s| s < total)
         .map(|&s| {
             let st = build_state(&cap.sections, &cap.frame, phi, s)?;
-            let b = state_buckling(&st, &state_material(cap, options, s)?, options)?;
+            let mat = state_material(
+                cap,
+                options,
+                s,
+                Some(&crate::analysis::green::CapGreen::new(cap)?),
+            );
+            let b = state_buckling(
+                &st,
+                &mat,
+                &options.with_split_at_most(2),
+                &Default::default(),
+            )?
+            .buckling;
             match b.status {
                 BucklingStatus::Analysed => Ok(b.factors.first().map(|&f| (s, f))),
                 // A mechanism cannot stand: BLF 0.

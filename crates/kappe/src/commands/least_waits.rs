@@ -27,7 +27,7 @@
 
 use serde::Serialize;
 
-use crate::analysis::buckling::state_material_with;
+use crate::analysis::buckling::state_material;
 use crate::analysis::green::{CapGreen, FailureMode};
 use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling};
 use crate::form::cap::Cap;
@@ -102,7 +102,7 @@ pub fn check_state_on(
     )?;
     let mut g = green.clone();
     g.schedule = schedule.clone();
-    let mut material = state_material_with(cap, options, top, Some(&g));
+    let mut material = state_material(cap, options, top, Some(&g));
     if !g.time.is_constant() {
         material.layer_modulus = g.layer_moduli(cap, top);
     }
@@ -110,7 +110,16 @@ pub fn check_state_on(
     // without a strength model (or a shell) the plain buckling check.
     let (b, checks) = match g.state_checks(&state, &material, options, top)? {
         Some((b, _, worst)) => (b, worst),
-        None => (state_buckling(&state, &material, options)?, None),
+        None => (
+            state_buckling(
+                &state,
+                &material,
+                &options.with_split_at_most(2),
+                &Default::default(),
+            )?
+            .buckling,
+            None,
+        ),
     };
     let blf = match b.status {
         BucklingStatus::Analysed => b.factors.first().copied(),

@@ -228,6 +228,16 @@ impl Default for AnalysisOptions {
 }
 
 impl AnalysisOptions {
+    /// These options with `blf_max_split` at most `n`: a single state solved outside
+    /// [`crate::analysis::analyze`] stops at the 2×2 split (`n` = 2), the first pass of
+    /// `analyze` at the print-layer mesh (`n` = 1; docs/convergence.md).
+    pub fn with_split_at_most(&self, n: usize) -> Self {
+        Self {
+            blf_max_split: self.blf_max_split.min(n),
+            ..self.clone()
+        }
+    }
+
     /// Check the options (typed errors naming the field).
     pub fn validate(&self) -> Result<(), DesignError> {
         let bad = |field: &'static str, value: String, allowed: &str| DesignError::Invalid {

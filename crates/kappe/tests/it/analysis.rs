@@ -243,7 +243,17 @@ fn shell_model_rows_supports_and_orientation() {
     let last = c.states.len() - 1;
     let state = build_state(&c.sections, &c.frame, 0.0, last).unwrap();
     let o = AnalysisOptions::default();
-    let sh = state_shell(&state, &state_material(&c, &o, last).unwrap(), 1).unwrap();
+    let sh = state_shell(
+        &state,
+        &state_material(
+            &c,
+            &o,
+            last,
+            Some(&kappe::analysis::CapGreen::new(&c).unwrap()),
+        ),
+        1,
+    )
+    .unwrap();
     // Consistent orientation, no degenerate facet, every node used.
     sh.model.validate().unwrap();
     // One row per printed layer, in print order.
@@ -304,11 +314,35 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
     let last = c.states.len() - 1;
     let state = build_state(&c.sections, &c.frame, 0.0, last).unwrap();
     let o = AnalysisOptions::default();
-    let b1 = state_buckling(&state, &state_material(&c, &o, last).unwrap(), &o).unwrap();
+    let b1 = state_buckling(
+        &state,
+        &state_material(
+            &c,
+            &o,
+            last,
+            Some(&kappe::analysis::CapGreen::new(&c).unwrap()),
+        ),
+        &o.with_split_at_most(2),
+        &Default::default(),
+    )
+    .unwrap()
+    .buckling;
     let mut d2 = d.clone();
     d2.material.youngs_modulus *= 2.0;
     let c2 = cap(&d2);
-    let b2 = state_buckling(&state, &state_material(&c2, &o, last).unwrap(), &o).unwrap();
+    let b2 = state_buckling(
+        &state,
+        &state_material(
+            &c2,
+            &o,
+            last,
+            Some(&kappe::analysis::CapGreen::new(&c2).unwrap()),
+        ),
+        &o.with_split_at_most(2),
+        &Default::default(),
+    )
+    .unwrap()
+    .buckling;
     // Linear buckling under dead load: BLF ∝ E exactly (buckling.md A11); 1e-6 covers the
     // Lanczos tolerance of 1e-8 on μ.
     assert!((b2.factors[0] / b1.factors[0] - 2.0).abs() < 1e-6);
@@ -324,13 +358,20 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
     });
     let ca = cap(&da);
     let aged = da.analysis.clone();
-    let m = state_material(&ca, &aged, last).unwrap();
+    let m = state_material(
+        &ca,
+        &aged,
+        last,
+        Some(&kappe::analysis::CapGreen::new(&ca).unwrap()),
+    );
     // The top layer is fresh, older ones stiffer, none above E_max.
     let top_id = c.sections.layers[last].id;
     assert_eq!(m.modulus_of(top_id), e);
     assert!(m.layer_modulus.values().all(|&v| v >= e && v <= 2.0 * e));
     assert!(m.modulus_of(c.sections.layers[0].id) > e);
-    let ba = state_buckling(&state, &m, &aged).unwrap();
+    let ba = state_buckling(&state, &m, &aged.with_split_at_most(2), &Default::default())
+        .unwrap()
+        .buckling;
     assert!(ba.factors[0] > b1.factors[0] && ba.factors[0] < b2.factors[0] * (1.0 + 1e-9));
 }
 
@@ -344,9 +385,21 @@ fn mechanism_is_reported_with_its_layer() {
     let q = 3;
     let state = build_state(&c.sections, &c.frame, 0.0, q).unwrap();
     let o = AnalysisOptions::default();
-    let mut sh = state_shell(&state, &state_material(&c, &o, q).unwrap(), 1).unwrap();
+    let mut sh = state_shell(
+        &state,
+        &state_material(
+            &c,
+            &o,
+            q,
+            Some(&kappe::analysis::CapGreen::new(&c).unwrap()),
+        ),
+        1,
+    )
+    .unwrap();
     sh.model.supports.clear();
-    let b = kappe::analysis::shell_buckling(&sh, q, &o).unwrap();
+    let b = kappe::analysis::shell_buckling(&sh, q, &o)
+        .unwrap()
+        .buckling;
     assert_eq!(b.status, BucklingStatus::Mechanism);
     assert!(b.factors.is_empty());
     let m = b.mechanism.unwrap();

@@ -21,9 +21,20 @@ fn final_blf(d: &Design) -> f64 {
         row_stride: 4,
         ..AnalysisOptions::default()
     };
-    state_buckling(&state, &state_material(&cap, &o, last).unwrap(), &o)
-        .unwrap()
-        .factors[0]
+    state_buckling(
+        &state,
+        &state_material(
+            &cap,
+            &o,
+            last,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        ),
+        &o.with_split_at_most(2),
+        &Default::default(),
+    )
+    .unwrap()
+    .buckling
+    .factors[0]
 }
 
 /// Geometrically similar caps (rise = span/4, same thickness): a longer span is more slender, so

@@ -229,7 +229,7 @@ fn the_cap_as_printed_pass_reports_every_state() {
 }
 
 /// The analysis solves each buckled state's as-printed increment inside its buckling solve's
-/// factorization of K (`state_buckling_printed`) instead of factorizing K again; the pass must
+/// factorization of K (`BucklingRequest::printed`) instead of factorizing K again; the pass must
 /// be exactly the stand-alone one (`cap_as_printed`: every increment its own linear static
 /// solve), bit for bit, on the full print-layer mesh and on a graded one (whose states the pass
 /// still solves itself).

@@ -11,7 +11,17 @@ fn splits(d: &kappe::Design, top: usize) -> [f64; 3] {
     let cap = kappe::design_cap(d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions::default();
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();
-    let shell = state_shell(&state, &state_material(&cap, &o, top).unwrap(), 1).unwrap();
+    let shell = state_shell(
+        &state,
+        &state_material(
+            &cap,
+            &o,
+            top,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        ),
+        1,
+    )
+    .unwrap();
     let opts = BucklingOptions {
         modes: 1,
         tolerance: 1e-8,
@@ -114,23 +124,29 @@ fn sampled_states_match_every_state_solved() {
 /// at most triples that (3e-5), rounded up.
 #[test]
 fn the_split_pass_continues_from_the_first_pass() {
-    use kappe::analysis::{state_buckling_mode, state_buckling_warm, state_refine};
+    use kappe::analysis::{state_buckling, state_refine};
     let d = kappe::Design::default();
     let cap = kappe::design_cap(&d, kappe::Context::default()).unwrap();
     let o = AnalysisOptions::default();
     let top = 40;
     let state = build_state(&cap.sections, &cap.frame, d.print.start_arch_fraction, top).unwrap();
-    let mat = state_material(&cap, &o, top).unwrap();
-    let scratch = state_buckling_mode(&state, &mat, &o)
+    let mat = state_material(
+        &cap,
+        &o,
+        top,
+        Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+    );
+    let scratch = state_buckling(&state, &mat, &o.with_split_at_most(2), &Default::default())
         .unwrap()
-        .0
+        .buckling
         .convergence
         .unwrap();
     let first = AnalysisOptions {
         blf_max_split: 1,
         ..o.clone()
     };
-    let (b, _, mode) = state_buckling_warm(&state, &mat, &first, None).unwrap();
+    let r = state_buckling(&state, &mat, &first, &Default::default()).unwrap();
+    let (b, mode) = (r.buckling, r.next);
     assert!(
         b.convergence.is_none(),
         "the first pass solves the layer mesh only"

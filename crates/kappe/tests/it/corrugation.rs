@@ -369,7 +369,12 @@ fn every_corrugated_state_is_in_equilibrium_network_plus_shell() {
     let last = cap.states.len() - 1;
     for top in [cap.sections.n_start + 4, last] {
         let state = build_state(&cap.sections, &cap.frame, 0.0, top).unwrap();
-        let mat = state_material(&cap, &o, top).unwrap();
+        let mat = state_material(
+            &cap,
+            &o,
+            top,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        );
         let (all, bending) = corrugated_stresses(&state, areas, &mat).unwrap();
         let b = bending.expect("a corrugated state has a bending part");
         assert!(b.load_sum_n > 0.0 && b.out_of_funicular_n > 0.0);
@@ -498,4 +503,51 @@ fn the_nozzle_follows_the_waves() {
     );
     let files = kappe_robot::files::linted_programs(&plan, "corrugated").unwrap();
     assert!(!files.is_empty());
+}
+
+/// Issue 26, speed: the analysis solves a corrugated state's bending part as a second load case
+/// of its buckling solve (`BucklingRequest::bending`), on the same factor of K. The stresses and
+/// the summary are then exactly the stand-alone `corrugated_stresses` (the same K, ordering and
+/// right-hand side: the same bits), and the buckling factors are those of the plain solve.
+#[test]
+fn the_bending_part_solved_in_the_buckling_solve_is_the_stand_alone_one() {
+    use kappe::analysis::{
+        AnalysisOptions, BucklingRequest, corrugated_stresses, state_buckling, state_material,
+    };
+    use kappe::form::build_state;
+    let cap = design_cap(&small(WAVE), kappe::Context::default()).unwrap();
+    let o = AnalysisOptions {
+        blf_max_split: 1,
+        ..AnalysisOptions::default()
+    };
+    let areas = cap.areas();
+    let last = cap.states.len() - 1;
+    for top in [cap.sections.n_start + 4, last] {
+        let state = build_state(&cap.sections, &cap.frame, 0.0, top).unwrap();
+        let mat = state_material(
+            &cap,
+            &o,
+            top,
+            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+        );
+        let alone = corrugated_stresses(&state, areas, &mat).unwrap();
+        assert!(alone.1.is_some(), "state {top} has a bending part");
+        for printed in [false, true] {
+            let request = BucklingRequest {
+                printed,
+                bending: Some(areas),
+                ..Default::default()
+            };
+            let r = state_buckling(&state, &mat, &o, &request).unwrap();
+            assert_eq!(r.stresses.as_ref(), Some(&alone), "state {top}");
+            assert_eq!(r.increment.is_some(), printed);
+            assert_eq!(
+                r.buckling.factors,
+                state_buckling(&state, &mat, &o, &Default::default())
+                    .unwrap()
+                    .buckling
+                    .factors
+            );
+        }
+    }
 }

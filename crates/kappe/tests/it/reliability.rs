@@ -74,11 +74,22 @@ fn buckling_scaling_matches_a_resolve() {
     let o = d.analysis.clone();
     let last = cap.states.len() - 1;
     let state = build_state(&cap.sections, &cap.frame, 0.0, last).unwrap();
-    let mut mat = state_material(&cap, &o, last).unwrap();
-    let blf0 = state_buckling(&state, &mat, &o).unwrap().factors[0];
+    let mut mat = state_material(
+        &cap,
+        &o,
+        last,
+        Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+    );
+    let blf0 = state_buckling(&state, &mat, &o.with_split_at_most(2), &Default::default())
+        .unwrap()
+        .buckling
+        .factors[0];
     mat.youngs_modulus *= 1.3;
     mat.unit_weight *= 0.8;
-    let blf1 = state_buckling(&state, &mat, &o).unwrap().factors[0];
+    let blf1 = state_buckling(&state, &mat, &o.with_split_at_most(2), &Default::default())
+        .unwrap()
+        .buckling
+        .factors[0];
     let table = with_uncertainty(
         "[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.2 }\n\
          \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n",

@@ -43,9 +43,20 @@ fn final_state_blf_drops_by_the_shear_share() {
             element,
             ..AnalysisOptions::default()
         };
-        state_buckling(&state, &state_material(&cap, &o, last).unwrap(), &o)
-            .unwrap()
-            .factors[0]
+        state_buckling(
+            &state,
+            &state_material(
+                &cap,
+                &o,
+                last,
+                Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
+            ),
+            &o.with_split_at_most(2),
+            &Default::default(),
+        )
+        .unwrap()
+        .buckling
+        .factors[0]
     };
     let (dkt, dkmt) = (blf(ElementKind::CstDkt), blf(ElementKind::AndesDkmt));
     let change = dkmt / dkt - 1.0;
