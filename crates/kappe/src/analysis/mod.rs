@@ -54,11 +54,13 @@ pub use stress::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use bending::corrugated_stresses;
-pub use blf_sensitivity::{blf_derivatives, time_state_blf};
+pub use blf_sensitivity::{blf_derivatives, time_state_blf, time_state_blf_ages};
 pub use buckling::{ModeGuess, state_buckling_warm, state_refine};
 pub use check::{StateFe, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
-pub use reliability::{Check, Vars, check_form, limit_state, prepare, state_form};
+pub use reliability::{
+    Check, GreenField, Vars, check_form, limit_state, prepare, scaled_ages, state_form,
+};
 pub use shell::state_shell;
