@@ -61,6 +61,6 @@ pub use collapse::{CURVE_POINTS, CollapseMode, cap_state_collapse};
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state};
 pub use reliability::{
-    Check, GreenField, Vars, check_form, limit_state, prepare, scaled_ages, state_form,
+    Check, GreenField, Vars, check_form, limit_state, prepare, reliability, scaled_ages, state_form,
 };
 pub use shell::state_shell;
