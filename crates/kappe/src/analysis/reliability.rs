@@ -327,6 +327,10 @@ pub struct TimeBuckling<'a> {
     pub blf_min: f64,
     /// λ of the shell at the nominal E₀, Ė (computed on first use).
     pub shell0: Option<f64>,
+    /// The last point evaluated, its g and ∂g/∂x: FORM asks for g at a line-search trial point
+    /// and then for g and its gradient at the same point once it is accepted; one re-solve
+    /// (eigensolve and sensitivity solves) serves both, and the numbers are the same.
+    pub last: Option<(Vec<f64>, f64, Vec<f64>)>,
 }
 
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
@@ -432,10 +436,24 @@ pub fn scaled_ages(
     (ages, print)
 }
 
+impl TimeBuckling<'_> {
+    /// g and ∂g/∂x at `x`, from the last evaluation when it was at the same point.
+    fn cached(&mut self, x: &[f64]) -> Result<(f64, Vec<f64>), kappe_reliability::EvalError> {
+        if let Some((at, g, grad)) = &self.last
+            && at.as_slice() == x
+        {
+            return Ok((*g, grad.clone()));
+        }
+        let mut grad = vec![0.0; x.len()];
+        let g = self.eval(x, &mut grad)?;
+        self.last = Some((x.to_vec(), g, grad.clone()));
+        Ok((g, grad))
+    }
+}
+
 impl kappe_reliability::LimitState for TimeBuckling<'_> {
     fn value(&mut self, x: &[f64]) -> Result<f64, kappe_reliability::EvalError> {
-        let mut g = vec![0.0; x.len()];
-        self.eval(x, &mut g)
+        self.cached(x).map(|(g, _)| g)
     }
 
     fn value_and_gradient(
@@ -443,7 +461,9 @@ impl kappe_reliability::LimitState for TimeBuckling<'_> {
         x: &[f64],
         grad: &mut [f64],
     ) -> Result<Option<f64>, kappe_reliability::EvalError> {
-        self.eval(x, grad).map(Some)
+        let (g, d) = self.cached(x)?;
+        grad.iter_mut().zip(&d).for_each(|(o, v)| *o = *v);
+        Ok(Some(g))
     }
 }
 
@@ -875,6 +895,7 @@ pub fn state_form(
                     check: (blf, s_nu, top),
                     blf_min: k.blf_min,
                     shell0: None,
+                    last: None,
                 }),
                 _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
                     limit_state(check, v, limits, x, grad)
