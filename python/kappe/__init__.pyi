@@ -5,6 +5,7 @@ import numpy as np
 from . import cem as cem
 from . import fe as fe
 from . import robot as robot
+from ._buildability import buildability_monte_carlo as buildability_monte_carlo
 from ._ceiling import CeilingResult as CeilingResult
 from ._ceiling import ceiling as ceiling
 from ._optimize import OptimizeResult as OptimizeResult

@@ -2,9 +2,9 @@
 //! `cargo run --release -p kappe --example buildability_mc`.
 //!
 //! The example spec (`kappe init --kind buildability`, 60 layers, every layer count checked)
-//! with an illustrative scatter (not calibrated to the five specimens): E₀, Ė, f₀, ḟ lognormal
-//! with coefficients of variation 0.15, 0.15, 0.10, 0.10, γ normal with 0.02 and the layer time
-//! lognormal with 0.05.
+//! with the illustrative scatter of `example_scatter` (not calibrated to the five
+//! specimens): E₀, Ė, f₀, ḟ lognormal with coefficients of variation 0.15, 0.15, 0.10, 0.10, γ
+//! normal with 0.02 and the layer time lognormal with 0.05.
 //!
 //! 1. Speed: the interpolation tables (9 points of ρ per layer count, 540 shell solves) and
 //!    10⁴ Monte Carlo samples of the whole print (60 layer counts each); target ≤ 60 s.
@@ -18,30 +18,23 @@ use std::time::Instant;
 mod measure;
 use measure::{cpu_seconds, load_average};
 
-use kappe::commands::buildability::{BuildabilitySpec, EXAMPLE_TOML, run};
+use kappe::commands::buildability::{BuildabilitySpec, run};
 use kappe::commands::buildability_reliability::{
-    Surrogate, monte_carlo, monte_carlo_batch, monte_carlo_result, prepare, reliability,
+    Surrogate, example_scatter, example_spec, monte_carlo, monte_carlo_batch, monte_carlo_result,
+    prepare, reliability,
 };
 use kappe_reliability::{Batch, SamplingOptions};
-
-const SCATTER: &str = r#"
-[uncertainty]
-"material.time.youngs_modulus" = { dist = "lognormal", cov = 0.15 }
-"material.time.youngs_modulus_rate" = { dist = "lognormal", cov = 0.15 }
-"material.time.compressive_strength" = { dist = "lognormal", cov = 0.10 }
-"material.time.compressive_strength_rate" = { dist = "lognormal", cov = 0.10 }
-"material.specific_weight" = { dist = "normal", cov = 0.02 }
-"process.layer_time" = { dist = "lognormal", cov = 0.05 }
-seed = 1
-"#;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let samples: u64 = std::env::args()
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
-    let text = EXAMPLE_TOML.replace("stop_at_failure = true", "stop_at_failure = false");
-    let mut spec = BuildabilitySpec::parse(&format!("{text}\n{SCATTER}"))?;
+    let mut spec = BuildabilitySpec::parse(&format!(
+        "{}{}",
+        example_spec(60, None, None),
+        example_scatter(1)
+    ))?;
     let table = spec.uncertainty.take().ok_or("no [uncertainty]")?;
     let r = spec.resolve()?;
     let det = run(&r, &|_| {})?;

@@ -12,10 +12,12 @@
 
 //!
 //! One module per area, as the package's Python modules: [`design`], [`study`], [`ceiling`],
-//! [`cem`], [`fe`], [`optimize`], [`robot`]; [`errors`] maps library errors to Python exceptions.
+//! [`cem`], [`fe`], [`optimize`], [`robot`], [`buildability`] (the Monte Carlo batches of a
+//! buildability print); [`errors`] maps library errors to Python exceptions.
 
 use pyo3::prelude::*;
 
+mod buildability;
 mod ceiling;
 mod cem;
 mod design;
@@ -59,5 +61,7 @@ fn _kappe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ceiling::ceiling_run_bay, m)?)?;
     m.add_function(wrap_pyfunction!(ceiling::ceiling_assemble, m)?)?;
     m.add_function(wrap_pyfunction!(ceiling::write_output, m)?)?;
+    m.add_function(wrap_pyfunction!(buildability::buildability_mc_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(buildability::buildability_mc_merge, m)?)?;
     Ok(())
 }

@@ -192,6 +192,23 @@ pub fn modulus_derivatives(time: &TimeModel, t: f64) -> [f64; 2] {
     }
 }
 
+/// ∂E/∂a of the time model's modulus at age `t` s: Ė for the linear law, Ė·e^{t/t_c} for the
+/// exponential one, 0 for the constant one and where the cap `youngs_modulus_max` holds E (a
+/// one-sided derivative, as [`modulus_derivatives`]).
+pub fn modulus_age_derivative(time: &TimeModel, t: f64) -> f64 {
+    let t = t.max(0.0);
+    let p = &time.youngs_modulus;
+    let [_, h] = modulus_derivatives(time, t);
+    if p.max.is_some_and(|m| p.initial + p.rate * h > m) {
+        return 0.0;
+    }
+    match time.law {
+        TimeLaw::Constant => 0.0,
+        TimeLaw::Linear => p.rate,
+        TimeLaw::Exponential => p.rate * (t / time.time_constant).exp(),
+    }
+}
+
 /// The lowest buckling factor of the cap state with top print index `top` under the time model
 /// `time` on `schedule` (the shell the analysis builds: grading and row stride of `options`),
 /// and its derivatives with respect to the time model's E₀ and Ė ([`blf_derivatives`]).
@@ -208,6 +225,29 @@ pub fn time_state_blf(
     top: usize,
     tolerance: f64,
 ) -> Result<Option<(f64, [f64; 2])>, DesignError> {
+    let ages = schedule.ages(top + 1);
+    Ok(
+        time_state_blf_ages(cap, options, &ages, &[], time, top, tolerance)?
+            .map(|(l, d)| (l, [d[0], d[1]])),
+    )
+}
+
+/// [`time_state_blf`] with the layers' ages given (`ages[k]`, layer k in print order) and,
+/// when `dages` is not empty, also ∂λ/∂s for ages a_k + s·`dages[k]` (the print speed's
+/// factor on the print durations: ∂E_e/∂s = E′(a)·∂a/∂s); the third derivative is 0 when
+/// `dages` is empty.
+///
+/// # Errors
+/// A state that cannot be built, a failed solve, or a mechanism.
+pub fn time_state_blf_ages(
+    cap: &Cap,
+    options: &AnalysisOptions,
+    ages: &[f64],
+    dages: &[f64],
+    time: &TimeModel,
+    top: usize,
+    tolerance: f64,
+) -> Result<Option<(f64, [f64; 3])>, DesignError> {
     let state = build_state(
         &cap.sections,
         &cap.frame,
@@ -215,13 +255,13 @@ pub fn time_state_blf(
         top,
     )?;
     let analysed = AnalysedState::new(&state, options.grading.as_ref());
-    let ages = schedule.ages(top + 1);
-    let age_of: HashMap<i32, f64> = cap
+    let age_of: HashMap<i32, (f64, f64)> = cap
         .sections
         .layers
         .iter()
-        .zip(&ages)
-        .map(|(l, &t)| (l.id, t))
+        .zip(ages)
+        .enumerate()
+        .map(|(k, (l, &t))| (l.id, (t, dages.get(k).copied().unwrap_or(0.0))))
         .collect();
     let d = &cap.design;
     let material = ShellMaterial {
@@ -230,7 +270,7 @@ pub fn time_state_blf(
         unit_weight: d.material.specific_weight,
         layer_modulus: age_of
             .iter()
-            .map(|(&id, &t)| (id, time.modulus(t)))
+            .map(|(&id, &(t, _))| (id, time.modulus(t)))
             .collect(),
         youngs_modulus: d.material.youngs_modulus,
         element: options.element,
@@ -256,21 +296,25 @@ pub fn time_state_blf(
         return Ok(None);
     };
     let ne = shell.element_layers.len();
-    let mut de = vec![Vec::with_capacity(ne), Vec::with_capacity(ne)];
+    let rows = if dages.is_empty() { 2 } else { 3 };
+    let mut de = vec![Vec::with_capacity(ne); rows];
     for (a, b) in &shell.element_layers {
         // The element takes the mean of its two layers' moduli (`state_shell`).
-        let da = modulus_derivatives(time, age_of.get(a).copied().unwrap_or(0.0));
-        let db = modulus_derivatives(time, age_of.get(b).copied().unwrap_or(0.0));
+        let (ta, sa) = age_of.get(a).copied().unwrap_or((0.0, 0.0));
+        let (tb, sb) = age_of.get(b).copied().unwrap_or((0.0, 0.0));
+        let da = modulus_derivatives(time, ta);
+        let db = modulus_derivatives(time, tb);
         for k in 0..2 {
             de[k].push(0.5 * (da[k] + db[k]));
         }
+        if let Some(row) = de.get_mut(2) {
+            row.push(
+                0.5 * (modulus_age_derivative(time, ta) * sa
+                    + modulus_age_derivative(time, tb) * sb),
+            );
+        }
     }
     let g = blf_derivatives(&shell.model, blf, mode, &r.static_result, &de).map_err(fe)?;
-    Ok(Some((
-        blf,
-        [
-            g.first().copied().unwrap_or(0.0),
-            g.get(1).copied().unwrap_or(0.0),
-        ],
-    )))
+    let get = |k: usize| g.get(k).copied().unwrap_or(0.0);
+    Ok(Some((blf, [get(0), get(1), get(2)])))
 }

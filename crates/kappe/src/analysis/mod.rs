@@ -57,7 +57,7 @@ pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, ana
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
 pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
 pub use bending::corrugated_stresses;
-pub use blf_sensitivity::{blf_derivatives, time_state_blf};
+pub use blf_sensitivity::{blf_derivatives, time_state_blf, time_state_blf_ages};
 pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
 pub use check::{FeRequest, StateFe, StateFeSolve, analysis_green, fe_runs, levers, state_fe};
 pub use collapse::{
@@ -66,5 +66,7 @@ pub use collapse::{
 };
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli};
-pub use reliability::{Check, Vars, check_form, limit_state, prepare, state_form};
+pub use reliability::{
+    Check, GreenField, Vars, check_form, limit_state, prepare, reliability, scaled_ages, state_form,
+};
 pub use shell::state_shell;

@@ -38,6 +38,7 @@ use super::check::Analysis;
 use crate::form::cap::Cap;
 use crate::form::states::build_state;
 use crate::input::error::DesignError;
+use crate::input::material::{Strength, TimeModel};
 use crate::input::uncertainty::BETA_MIN_DEFAULT;
 
 /// Absolute step in ν of the central difference ∂BLF/∂ν: small against ν's range (0, 0.5) and its
@@ -120,8 +121,13 @@ pub enum Check {
     Tension(f64),
     /// u₀.
     Strength(f64),
-    /// Buckling with the time model's E₀ and/or Ė uncertain: BLF₀, s_ν and the state's top
-    /// print index; g from re-solves of the state's shell ([`TimeBuckling`]).
+    /// Strength and bed-joint sliding of the state layer by layer, when a strength parameter or
+    /// the print speed is uncertain: one component per layer and check ([`GreenField`]); the
+    /// state's stresses from one static solve of its shell, u₀ the deterministic utilisation.
+    GreenLayers(f64),
+    /// Buckling with the time model's E₀ and/or Ė (or the print speed) uncertain: BLF₀, s_ν
+    /// and the state's top print index; g from re-solves of the state's shell
+    /// ([`TimeBuckling`]).
     BucklingTime {
         /// BLF at the design's values.
         blf: f64,
@@ -138,7 +144,7 @@ impl Check {
             Check::Buckling { .. } | Check::BucklingTime { .. } => "buckling",
             Check::Compression(_) => "sigma_min",
             Check::Tension(_) => "sigma_max",
-            Check::Strength(_) => "strength",
+            Check::Strength(_) | Check::GreenLayers(_) => "strength",
         }
     }
 }
@@ -155,12 +161,66 @@ pub struct Vars {
     /// The time model's E₀ and Ė (`material.time.*`).
     e0t: Option<usize>,
     rate: Option<usize>,
+    /// The time model's strength at age 0 (f₀ or c₀), its rate and the friction angle (°).
+    f0: Option<usize>,
+    frate: Option<usize>,
+    phi: Option<usize>,
+    /// The print speed and its nominal value.
+    speed: Option<usize>,
+    speed0: f64,
 }
 
 impl Vars {
-    /// Whether a time-model parameter is uncertain.
+    /// Whether a parameter of the layers' moduli is uncertain: the time model's E₀ or Ė, or
+    /// the print speed (it moves every layer's age).
     pub fn has_time(&self) -> bool {
-        self.e0t.is_some() || self.rate.is_some()
+        self.e0t.is_some() || self.rate.is_some() || self.speed.is_some()
+    }
+
+    /// Whether a parameter of the layers' capacities is uncertain: a strength parameter or the
+    /// print speed.
+    pub fn has_capacity(&self) -> bool {
+        self.f0.is_some() || self.frate.is_some() || self.phi.is_some() || self.speed.is_some()
+    }
+
+    /// The factor s = v₀/v on every layer's print duration at the point `x`.
+    pub fn age_scale(&self, x: &[f64]) -> f64 {
+        self.speed
+            .and_then(|i| x.get(i))
+            .map_or(1.0, |v| self.speed0 / v)
+    }
+
+    /// `time` with the time-model parameters of the point `x` (E₀, Ė, the strength at age 0,
+    /// its rate, φ; the others as given).
+    pub fn time_at(&self, time: &TimeModel, x: &[f64]) -> TimeModel {
+        let at = |i: Option<usize>| i.and_then(|i| x.get(i).copied());
+        let mut t = time.clone();
+        if let Some(e) = at(self.e0t) {
+            t.youngs_modulus.initial = e;
+        }
+        if let Some(r) = at(self.rate) {
+            t.youngs_modulus.rate = r;
+        }
+        match &mut t.strength {
+            Some(Strength::Uniaxial {
+                compressive_strength: p,
+                friction_angle_deg,
+            }) => {
+                p.initial = at(self.f0).unwrap_or(p.initial);
+                p.rate = at(self.frate).unwrap_or(p.rate);
+                *friction_angle_deg = at(self.phi).unwrap_or(*friction_angle_deg);
+            }
+            Some(Strength::MohrCoulomb {
+                cohesion: p,
+                friction_angle_deg,
+            }) => {
+                p.initial = at(self.f0).unwrap_or(p.initial);
+                p.rate = at(self.frate).unwrap_or(p.rate);
+                friction_angle_deg.initial = at(self.phi).unwrap_or(friction_angle_deg.initial);
+            }
+            None => {}
+        }
+        t
     }
 }
 
@@ -178,6 +238,12 @@ impl Vars {
             nu0: m.poisson_ratio,
             e0t: find("material.time.youngs_modulus"),
             rate: find("material.time.youngs_modulus_rate"),
+            f0: find("material.time.compressive_strength").or(find("material.time.cohesion")),
+            frate: find("material.time.compressive_strength_rate")
+                .or(find("material.time.cohesion_rate")),
+            phi: find("material.time.friction_angle_deg"),
+            speed: find(crate::input::uncertainty::SPEED),
+            speed0: cap.design.print.print_speed,
         }
     }
 }
@@ -219,7 +285,9 @@ pub fn limit_state(
             set(v.gamma, -s / v.gamma0);
             sigma_max - s * rg
         }
-        Check::Strength(u) => {
+        // The layer components need the state's stresses ([`GreenField`]); here the
+        // nominal-capacity value, which keeps this pure function total.
+        Check::Strength(u) | Check::GreenLayers(u) => {
             set(v.gamma, -u / v.gamma0);
             1.0 - u * rg
         }
@@ -259,6 +327,10 @@ pub struct TimeBuckling<'a> {
     pub blf_min: f64,
     /// λ of the shell at the nominal E₀, Ė (computed on first use).
     pub shell0: Option<f64>,
+    /// The last point evaluated, its g and ∂g/∂x: FORM asks for g at a line-search trial point
+    /// and then for g and its gradient at the same point once it is accepted; one re-solve
+    /// (eigensolve and sensitivity solves) serves both, and the numbers are the same.
+    pub last: Option<(Vec<f64>, f64, Vec<f64>)>,
 }
 
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
@@ -266,40 +338,53 @@ pub struct TimeBuckling<'a> {
 pub const RESOLVE_TOLERANCE: f64 = 1e-8;
 
 impl TimeBuckling<'_> {
-    fn solve(&self, e0: f64, rate: f64) -> Result<(f64, [f64; 2]), kappe_reliability::EvalError> {
-        let mut time = self.time.clone();
-        time.youngs_modulus.initial = e0;
-        time.youngs_modulus.rate = rate;
+    /// λ and (∂λ/∂E₀, ∂λ/∂Ė, ∂λ/∂s) at the point `x` (nominal values where None), s = v₀/v
+    /// the factor on every print duration.
+    fn solve(&self, x: Option<&[f64]>) -> Result<(f64, [f64; 3]), kappe_reliability::EvalError> {
         let top = self.check.2;
-        crate::analysis::blf_sensitivity::time_state_blf(
+        let (time, scale) = match x {
+            Some(x) => (self.vars.time_at(&self.time, x), self.vars.age_scale(x)),
+            None => (self.time.clone(), 1.0),
+        };
+        let (ages, print) = scaled_ages(self.schedule, top, scale);
+        let dages = if self.vars.speed.is_some() {
+            print
+        } else {
+            Vec::new()
+        };
+        crate::analysis::blf_sensitivity::time_state_blf_ages(
             self.cap,
             self.options,
-            self.schedule,
+            &ages,
+            &dages,
             &time,
             top,
             RESOLVE_TOLERANCE,
         )?
         .ok_or_else(|| {
-            format!("state {top}: no positive buckling factor at E₀ = {e0} Pa, Ė = {rate} Pa/s")
-                .into()
+            format!(
+                "state {top}: no positive buckling factor at E₀ = {} Pa, Ė = {} Pa/s, print \
+                 durations × {scale}",
+                time.youngs_modulus.initial, time.youngs_modulus.rate
+            )
+            .into()
         })
     }
 
     fn eval(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, kappe_reliability::EvalError> {
         let v = self.vars;
-        let p = self.time.youngs_modulus;
         let at =
             |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
         let shell0 = match self.shell0 {
             Some(l) => l,
             None => {
-                let l = self.solve(p.initial, p.rate)?.0;
+                let l = self.solve(None)?.0;
                 self.shell0 = Some(l);
                 l
             }
         };
         let (blf, s_nu, _) = self.check;
-        let (l, dl) = self.solve(at(v.e0t, p.initial), at(v.rate, p.rate))?;
+        let (l, dl) = self.solve(Some(x))?;
         let gamma = at(v.gamma, v.gamma0);
         let rg = gamma / v.gamma0;
         let nu = at(v.nu, v.nu0);
@@ -314,16 +399,61 @@ impl TimeBuckling<'_> {
         };
         set(v.e0t, k * dl[0] / rg * lin);
         set(v.rate, k * dl[1] / rg * lin);
+        // s = v₀/v: ∂s/∂v = −s/v.
+        let speed = at(v.speed, v.speed0);
+        set(v.speed, -k * dl[2] * (v.speed0 / speed) / speed / rg * lin);
         set(v.gamma, -val / gamma);
         set(v.nu, k * l / rg * s_nu);
         Ok(val - self.blf_min)
     }
 }
 
+/// The ages of layers 0..=`top` at the state with top print index `top` when every print
+/// duration is scaled by `scale` (the pauses kept), and their derivative with respect to
+/// `scale`, the print time D_k after layer k: a_k(s) = a_k + (s − 1)·D_k, exactly the nominal
+/// ages at s = 1.
+pub fn scaled_ages(
+    schedule: &crate::schedule::Schedule,
+    top: usize,
+    scale: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let nominal = schedule.ages(top + 1);
+    let mut print = vec![0.0; nominal.len()];
+    let mut d = 0.0;
+    for k in (0..nominal.len()).rev() {
+        print[k] = d;
+        d += schedule.layers.get(k).map_or(0.0, |l| l.end_s - l.start_s);
+    }
+    let ages = if scale == 1.0 {
+        nominal
+    } else {
+        nominal
+            .iter()
+            .zip(&print)
+            .map(|(a, p)| a + (scale - 1.0) * p)
+            .collect()
+    };
+    (ages, print)
+}
+
+impl TimeBuckling<'_> {
+    /// g and ∂g/∂x at `x`, from the last evaluation when it was at the same point.
+    fn cached(&mut self, x: &[f64]) -> Result<(f64, Vec<f64>), kappe_reliability::EvalError> {
+        if let Some((at, g, grad)) = &self.last
+            && at.as_slice() == x
+        {
+            return Ok((*g, grad.clone()));
+        }
+        let mut grad = vec![0.0; x.len()];
+        let g = self.eval(x, &mut grad)?;
+        self.last = Some((x.to_vec(), g, grad.clone()));
+        Ok((g, grad))
+    }
+}
+
 impl kappe_reliability::LimitState for TimeBuckling<'_> {
     fn value(&mut self, x: &[f64]) -> Result<f64, kappe_reliability::EvalError> {
-        let mut g = vec![0.0; x.len()];
-        self.eval(x, &mut g)
+        self.cached(x).map(|(g, _)| g)
     }
 
     fn value_and_gradient(
@@ -331,7 +461,9 @@ impl kappe_reliability::LimitState for TimeBuckling<'_> {
         x: &[f64],
         grad: &mut [f64],
     ) -> Result<Option<f64>, kappe_reliability::EvalError> {
-        self.eval(x, grad).map(Some)
+        let (g, d) = self.cached(x)?;
+        grad.iter_mut().zip(&d).for_each(|(o, v)| *o = *v);
+        Ok(Some(g))
     }
 }
 
@@ -445,11 +577,239 @@ pub fn checks_of(
                 checks.push(Check::Tension(smax));
             }
         }
-        if let Some(u) = s.strength.filter(|u| *u > 0.0) {
+        if let Some(u) = s.strength.filter(|u| *u > 0.0)
+            && !v.has_capacity()
+        {
             checks.push(Check::Strength(u));
         }
     }
+    if let Some(u) = s.strength.filter(|u| *u > 0.0)
+        && v.has_capacity()
+    {
+        checks.push(Check::GreenLayers(u));
+    }
     Ok(checks)
+}
+
+/// The membrane stresses of one state's shell at the design's values, layer by layer: what the
+/// strength and bed-joint sliding checks need when the layers' capacities are uncertain
+/// (docs/reliability.md, "Strength parameters and the print speed").
+///
+/// Layer k's capacity is the time model's Mohr–Coulomb c, φ at its age a_k, and its age moves
+/// with the print speed v as a_k(s) = a_k + (s − 1)·D_k, s = v₀/v, D_k the print time after it
+/// (pauses kept). The stresses scale exactly with γ (the load is linear in it) and do not
+/// depend on the capacities; they are held at the design's moduli, so the redistribution by a
+/// change of the moduli' ages (uncertain Ė, E₀ or v with E(t) not constant) is not followed
+/// (docs/reliability.md, Limits). Layer k's utilisation is the largest of its elements' (each
+/// element checked at the age of its younger layer, as the deterministic check does).
+#[derive(Debug, Clone)]
+pub struct GreenField {
+    /// Age of layers 0..=top at the state on the run's schedule, s.
+    pub ages: Vec<f64>,
+    /// D_k: the print time after layer k, s (∂a_k/∂s).
+    pub print: Vec<f64>,
+    /// Per layer: the principal membrane stresses (σ₁, σ₂) of its elements, Pa.
+    pub strength: Vec<Vec<[f64; 2]>>,
+    /// Per layer: the bed-joint (σ_n, τ) of its elements, Pa.
+    pub sliding: Vec<Vec<[f64; 2]>>,
+}
+
+/// Layers whose nominal utilisation is below this share of the state's worst are left out of
+/// its components: their ln-margin is larger by ln 5 = 1.6, about 16 standard deviations of a
+/// 10 % scatter, so they add nothing to the state's P_f (as the buildability objects' layers).
+pub const LAYER_SHARE: f64 = 0.2;
+
+impl GreenField {
+    /// One static solve of the state with top print index `top` on `schedule`, on the shell the
+    /// deterministic strength check uses (the grading's stress zones, `options.row_stride`).
+    /// None: no strength model or no shell (a single layer, a mechanism).
+    ///
+    /// # Errors
+    /// A state that cannot be built or a failed solve.
+    pub fn solve(
+        cap: &Cap,
+        options: &super::AnalysisOptions,
+        schedule: &crate::schedule::Schedule,
+        top: usize,
+    ) -> Result<Option<GreenField>, DesignError> {
+        use crate::analysis::green::{bed_traction, principal};
+        let green = crate::analysis::green::CapGreen::with_schedule(cap, Some(schedule))?;
+        if green.time.strength.is_none() {
+            return Ok(None);
+        }
+        let state = build_state(
+            &cap.sections,
+            &cap.frame,
+            cap.design.print.start_arch_fraction,
+            top,
+        )?;
+        let mut material = state_material(cap, options, top, Some(&green));
+        if !green.time.is_constant() {
+            material.layer_modulus = green.layer_moduli(cap, top);
+        }
+        let grading = options
+            .grading
+            .as_ref()
+            .map(crate::analysis::graded::Grading::for_stresses);
+        let analysed = crate::analysis::graded::AnalysedState::new(&state, grading.as_ref());
+        let Ok(shell) =
+            crate::analysis::shell::state_shell(analysed.state(), &material, options.row_stride)
+        else {
+            return Ok(None);
+        };
+        let st = match kappe_fe::linear_static(&shell.model) {
+            Ok(st) => st,
+            Err(kappe_fe::FeError::Mechanism { .. }) => return Ok(None),
+            Err(e) => {
+                return Err(DesignError::State {
+                    state: top,
+                    message: format!("static solve for the reliability analysis failed: {e}"),
+                });
+            }
+        };
+        let (ages, print) = scaled_ages(schedule, top, 1.0);
+        let n = ages.len();
+        let mut field = GreenField {
+            ages,
+            print,
+            strength: vec![Vec::new(); n],
+            sliding: vec![Vec::new(); n],
+        };
+        for (res, info) in st.elements.iter().zip(green.element_layers(&shell)) {
+            let [sx, sy, sxy] = res.membrane_stress();
+            let (s1, s2) = principal(sx, sy, sxy);
+            let (sn, tau) = bed_traction(&res.frame, [sx, sy, sxy], info.bed_normal);
+            if let (Some(a), Some(b)) = (
+                field.strength.get_mut(info.younger),
+                field.sliding.get_mut(info.younger),
+            ) {
+                a.push([s1, s2]);
+                b.push([sn, tau]);
+            }
+        }
+        Ok(Some(field))
+    }
+
+    /// The strength (or, with `sliding`, the bed-joint sliding) utilisation of `layer` (None:
+    /// the largest over the state's layers) at the point `x` of the model `v` describes, under
+    /// the design's time model `time`. Exactly the deterministic check's utilisation at the
+    /// design's values.
+    pub fn utilisation(
+        &self,
+        v: Vars,
+        time: &TimeModel,
+        x: &[f64],
+        layer: Option<usize>,
+        sliding: bool,
+    ) -> f64 {
+        let r = v.gamma.and_then(|i| x.get(i)).map_or(1.0, |g| g / v.gamma0);
+        let s = v.age_scale(x);
+        let t = v.time_at(time, x);
+        let one = |k: usize| -> f64 {
+            let age = self.ages.get(k).copied().unwrap_or(0.0)
+                + (s - 1.0) * self.print.get(k).copied().unwrap_or(0.0);
+            let Some(mc) = t.mohr_coulomb(age) else {
+                return 0.0;
+            };
+            let rows = if sliding {
+                &self.sliding
+            } else {
+                &self.strength
+            };
+            rows.get(k).map_or(0.0, |row| {
+                row.iter().fold(0.0_f64, |m, &[a, b]| {
+                    m.max(if sliding {
+                        mc.sliding_utilisation(r * b, r * a)
+                    } else {
+                        mc.utilisation(r * a, r * b)
+                    })
+                })
+            })
+        };
+        match layer {
+            Some(k) => one(k),
+            None => (0..self.ages.len()).map(one).fold(0.0, f64::max),
+        }
+    }
+
+    /// The state's strength and sliding components: per check, one per layer within
+    /// [`LAYER_SHARE`] of the worst nominal utilisation (each layer's utilisation is smooth in
+    /// the parameters, their maximum is not: the worst layer moves between the old bottom and
+    /// the young top as f₀ and ḟ trade off, and HL-RF would zigzag on that kink), each
+    /// g = −ln u (the failure surface of 1 − u, nearly linear in u-space for the products of
+    /// powers u is made of). Gradients: FORM's central differences (10⁻⁵ standard deviations;
+    /// g is closed-form and cheap).
+    pub fn components<'a>(
+        &'a self,
+        v: Vars,
+        time: &'a TimeModel,
+    ) -> Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)> {
+        let x0 = self.nominal_point(v, time);
+        let mut out: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)> = Vec::new();
+        for (name, sliding) in [("strength", false), ("sliding", true)] {
+            let worst = self.utilisation(v, time, &x0, None, sliding);
+            for k in 0..self.ages.len() {
+                let u = self.utilisation(v, time, &x0, Some(k), sliding);
+                if !(u > 0.0 && u.is_finite() && u >= LAYER_SHARE * worst) {
+                    continue;
+                }
+                let g = move |x: &[f64]| -> Result<f64, kappe_reliability::EvalError> {
+                    let u = self.utilisation(v, time, x, Some(k), sliding);
+                    if u > 0.0 && !u.is_nan() {
+                        Ok(-u.ln())
+                    } else {
+                        Err(format!("layer {k}: {name} utilisation {u} at x = {x:?}").into())
+                    }
+                };
+                out.push((name, Box::new(kappe_reliability::Fallible(g))));
+            }
+        }
+        out
+    }
+
+    /// The design's values of every variable `v` knows (a point where `utilisation` gives the
+    /// deterministic one).
+    fn nominal_point(&self, v: Vars, time: &TimeModel) -> Vec<f64> {
+        let n = [
+            v.gamma, v.e, v.nu, v.e0t, v.rate, v.f0, v.frate, v.phi, v.speed,
+        ]
+        .iter()
+        .flatten()
+        .max()
+        .map_or(0, |m| m + 1);
+        let mut x = vec![f64::NAN; n];
+        let mut put = |i: Option<usize>, val: f64| {
+            if let Some(s) = i.and_then(|i| x.get_mut(i)) {
+                *s = val;
+            }
+        };
+        put(v.gamma, v.gamma0);
+        put(v.e, v.e0);
+        put(v.nu, v.nu0);
+        put(v.e0t, time.youngs_modulus.initial);
+        put(v.rate, time.youngs_modulus.rate);
+        put(v.speed, v.speed0);
+        match time.strength {
+            Some(Strength::Uniaxial {
+                compressive_strength: p,
+                friction_angle_deg,
+            }) => {
+                put(v.f0, p.initial);
+                put(v.frate, p.rate);
+                put(v.phi, friction_angle_deg);
+            }
+            Some(Strength::MohrCoulomb {
+                cohesion: p,
+                friction_angle_deg,
+            }) => {
+                put(v.f0, p.initial);
+                put(v.frate, p.rate);
+                put(v.phi, friction_angle_deg.initial);
+            }
+            None => {}
+        }
+        x
+    }
 }
 
 /// A design's uncertain model, its drifts and where the variables sit.
@@ -514,25 +874,44 @@ pub fn state_form(
     } else {
         None
     };
-    let mut states: Vec<Box<dyn kappe_reliability::LimitState + '_>> = Vec::new();
+    let field = match checks.iter().find(|c| matches!(c, Check::GreenLayers(_))) {
+        Some(_) => GreenField::solve(cap, options, schedule, index)?
+            .map(|f| (f, cap.design.time_model()))
+            .map(|(f, t)| t.map(|t| (f, t)))
+            .transpose()?,
+        None => None,
+    };
+    let mut named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = Vec::new();
     for &check in checks {
-        states.push(match (check, &time) {
-            (Check::BucklingTime { blf, s_nu, top }, Some(time)) => Box::new(TimeBuckling {
-                cap,
-                options,
-                schedule,
-                time: time.clone(),
-                vars: v,
-                check: (blf, s_nu, top),
-                blf_min: k.blf_min,
-                shell0: None,
-            }),
-            _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
-                limit_state(check, v, limits, x, grad)
-            })),
-        });
+        if let Check::GreenLayers(_) = check {
+            if let Some((field, time)) = &field {
+                named.extend(field.components(v, time));
+            }
+            continue;
+        }
+        named.push((
+            check.name(),
+            match (check, &time) {
+                (Check::BucklingTime { blf, s_nu, top }, Some(time)) => Box::new(TimeBuckling {
+                    cap,
+                    options,
+                    schedule,
+                    time: time.clone(),
+                    vars: v,
+                    check: (blf, s_nu, top),
+                    blf_min: k.blf_min,
+                    shell0: None,
+                    last: None,
+                }),
+                _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
+                    limit_state(check, v, limits, x, grad)
+                })),
+            },
+        ));
     }
-    let named = checks.iter().map(|c| c.name()).zip(states).collect();
+    if named.is_empty() {
+        return Ok(None);
+    }
     form_checks(&state_model, named, index, t_hours, seed)
         .map(Some)
         .map_err(rel_err)

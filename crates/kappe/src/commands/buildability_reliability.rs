@@ -97,6 +97,45 @@ fn nominal(r: &Resolved) -> [f64; 6] {
     ]
 }
 
+/// The example spec (`kappe init --kind buildability`, the Wolfs 2018 cylinder) with every layer
+/// count checked up to `max_layers`, `segments` shell elements around (None: the default 48) and
+/// its strength at age 0 replaced by `f0` Pa (None: kept); append [`example_scatter`] for the
+/// uncertain one. The buildability fixture of the `buildability_mc` example and the tests.
+pub fn example_spec(max_layers: usize, segments: Option<usize>, f0: Option<f64>) -> String {
+    let mut text = crate::commands::buildability::EXAMPLE_TOML
+        .replace("max_layers = 60 ", &format!("max_layers = {max_layers} "))
+        .replace("stop_at_failure = true", "stop_at_failure = false");
+    if let Some(n) = segments {
+        text = text.replace("# segments = 48 ", &format!("segments = {n} "));
+    }
+    if let Some(f) = f0 {
+        text = text.replace(
+            "compressive_strength = 5984.0",
+            &format!("compressive_strength = {f:?}"),
+        );
+    }
+    text
+}
+
+/// An illustrative scatter of [`example_spec`]'s mix, not calibrated to the five specimens: E₀,
+/// Ė, f₀, ḟ lognormal with coefficients of variation 0.15, 0.15, 0.10, 0.10, γ normal with 0.02
+/// and the layer time lognormal with 0.05, sampled with `seed`: an `[uncertainty]` table to
+/// append (more keys of the table may follow it).
+pub fn example_scatter(seed: u64) -> String {
+    format!(
+        "
+[uncertainty]
+\"material.time.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}
+\"material.time.youngs_modulus_rate\" = {{ dist = \"lognormal\", cov = 0.15 }}
+\"material.time.compressive_strength\" = {{ dist = \"lognormal\", cov = 0.10 }}
+\"material.time.compressive_strength_rate\" = {{ dist = \"lognormal\", cov = 0.10 }}
+\"material.specific_weight\" = {{ dist = \"normal\", cov = 0.02 }}
+\"process.layer_time\" = {{ dist = \"lognormal\", cov = 0.05 }}
+seed = {seed}
+"
+    )
+}
+
 fn uerr(field: impl Into<String>, message: impl Into<String>) -> DesignError {
     DesignError::Uncertainty {
         field: field.into(),

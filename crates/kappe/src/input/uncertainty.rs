@@ -34,12 +34,18 @@ use crate::input::error::DesignError;
 pub const BETA_MIN_DEFAULT: f64 = 2.3;
 
 /// The names `[uncertainty]` accepts, whether each is positive, and how it enters the analysis.
-pub const PARAMETERS: [(&str, bool); 5] = [
+pub const PARAMETERS: [(&str, bool); 11] = [
     ("material.specific_weight", false),
     ("material.youngs_modulus", true),
     ("material.poisson_ratio", true),
     ("material.time.youngs_modulus", true),
     ("material.time.youngs_modulus_rate", true),
+    ("material.time.compressive_strength", true),
+    ("material.time.compressive_strength_rate", true),
+    ("material.time.cohesion", true),
+    ("material.time.cohesion_rate", true),
+    ("material.time.friction_angle_deg", true),
+    ("print.print_speed", true),
 ];
 
 /// The time model's parameters among [`PARAMETERS`]: they set every layer's modulus by its age,
@@ -49,6 +55,21 @@ pub const TIME_PARAMETERS: [&str; 2] = [
     "material.time.youngs_modulus",
     "material.time.youngs_modulus_rate",
 ];
+
+/// The time model's strength parameters among [`PARAMETERS`]: they set every layer's capacity
+/// by its age and enter the strength and bed-joint sliding checks layer by layer
+/// (`crate::analysis::reliability`, "Strength parameters and the print speed").
+pub const STRENGTH_PARAMETERS: [&str; 5] = [
+    "material.time.compressive_strength",
+    "material.time.compressive_strength_rate",
+    "material.time.cohesion",
+    "material.time.cohesion_rate",
+    "material.time.friction_angle_deg",
+];
+
+/// The print speed: every layer's print duration is its path length over it, so it moves every
+/// layer's age through the schedule (the pauses — waits, station changes — do not move).
+pub const SPEED: &str = "print.print_speed";
 
 /// A parameter's nominal value and whether it is positive, or why its name is not allowed.
 pub type Lookup<'a> = dyn Fn(&str) -> Result<(f64, bool), String> + 'a;
@@ -100,7 +121,76 @@ pub fn nominal(design: &Design, name: &str) -> Option<f64> {
                 t.youngs_modulus.initial
             })
         }
+        "print.print_speed" => Some(design.print.print_speed),
+        _ if STRENGTH_PARAMETERS.contains(&name) => {
+            strength_nominal(&design.time_model().ok()?, name).ok()
+        }
         _ => None,
+    }
+}
+
+/// The nominal value of strength parameter `name` in `time`, or why the time model has none.
+pub fn strength_nominal(
+    time: &crate::input::material::TimeModel,
+    name: &str,
+) -> Result<f64, String> {
+    use crate::input::material::Strength;
+    let form = |given: &str, other: &str| {
+        format!(
+            "the design gives its strength as {given}; this parameter belongs to the other \
+             form, {other} — make the design's own strength parameters uncertain"
+        )
+    };
+    match (time.strength, name) {
+        (None, _) => Err(
+            "a strength parameter needs a strength model: give [material.time] \
+                          compressive_strength (uniaxial, optional friction_angle_deg) or \
+                          cohesion + friction_angle_deg"
+                .to_owned(),
+        ),
+        (
+            Some(Strength::Uniaxial {
+                compressive_strength: p,
+                ..
+            }),
+            _,
+        ) if name.starts_with("material.time.compressive_strength") => {
+            Ok(if name.ends_with("_rate") {
+                p.rate
+            } else {
+                p.initial
+            })
+        }
+        (
+            Some(Strength::Uniaxial {
+                friction_angle_deg, ..
+            }),
+            "material.time.friction_angle_deg",
+        ) => Ok(friction_angle_deg),
+        (Some(Strength::Uniaxial { .. }), _) => Err(form(
+            "compressive_strength (uniaxial)",
+            "cohesion + friction_angle_deg",
+        )),
+        (Some(Strength::MohrCoulomb { cohesion: p, .. }), _)
+            if name.starts_with("material.time.cohesion") =>
+        {
+            Ok(if name.ends_with("_rate") {
+                p.rate
+            } else {
+                p.initial
+            })
+        }
+        (
+            Some(Strength::MohrCoulomb {
+                friction_angle_deg: p,
+                ..
+            }),
+            "material.time.friction_angle_deg",
+        ) => Ok(p.initial),
+        (Some(Strength::MohrCoulomb { .. }), _) => Err(form(
+            "cohesion + friction_angle_deg (Mohr–Coulomb)",
+            "compressive_strength",
+        )),
     }
 }
 
@@ -147,6 +237,17 @@ impl UncertaintyTable {
                      (e.g. model = \"linear\" with youngs_modulus_rate)"
                         .to_owned(),
                 );
+            }
+            if name == SPEED && !time_model {
+                return Err(
+                    "the print speed only moves the layers' ages, which no check of a design \
+                     without a time model uses; give [material.time]"
+                        .to_owned(),
+                );
+            }
+            if STRENGTH_PARAMETERS.contains(&name) {
+                let time = design.time_model().map_err(|e| e.to_string())?;
+                return strength_nominal(&time, name).map(|v| (v, true));
             }
             let positive = PARAMETERS.iter().find(|(n, _)| *n == name).map(|p| p.1);
             match (nominal(design, name), positive) {

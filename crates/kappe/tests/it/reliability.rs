@@ -3,7 +3,7 @@
 //! table.
 
 use kappe::analysis::{AnalysisOptions, StateSelection, state_buckling, state_material};
-use kappe::analysis::{Check, Vars, check_form, limit_state};
+use kappe::analysis::{Check, GreenField, Vars, check_form, limit_state, prepare, scaled_ages};
 use kappe::form::build_state;
 use kappe::{Design, Options, design_cap, no_progress, run};
 use kappe_reliability::{SamplingOptions, WithGradient, monte_carlo};
@@ -433,8 +433,8 @@ fn study14_drying_mix_and_the_waits_that_keep_beta() {
 /// in the Monte Carlo's 95 % (Wilson) interval.
 #[test]
 fn form_of_a_time_parameter_state_agrees_with_monte_carlo() {
+    use kappe::analysis::state_form;
     use kappe::analysis::time_state_blf;
-    use kappe::analysis::{prepare, state_form};
     let mut d = study14(None);
     let u = with_uncertainty(
         "[material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
@@ -542,5 +542,245 @@ fn form_of_a_time_parameter_state_agrees_with_monte_carlo() {
         results[0].1.beta,
         mc.pf,
         mc.interval
+    );
+}
+
+/// The small cap with a strength model: E constant in time unless `e_rate` > 0 (linear law),
+/// uniaxial strength f(t) = `f0` + `f_rate`·t with friction angle `phi` (degrees).
+fn green_cap(e_rate: f64, f0: f64, f_rate: f64, phi: f64) -> Design {
+    let mut d = small();
+    d.material.time = Some(kappe::input::TimeModelSpec {
+        model: Some(kappe::input::TimeLaw::Linear),
+        youngs_modulus: Some(d.material.youngs_modulus),
+        youngs_modulus_rate: Some(e_rate),
+        compressive_strength: Some(f0),
+        compressive_strength_rate: Some(f_rate),
+        friction_angle_deg: Some(phi),
+        ..Default::default()
+    });
+    d
+}
+
+/// The `[uncertainty]` table `table` (its entries), parsed alone: a design file's parse checks
+/// it against that file's own material, which here is set in code.
+fn table_of(table: &str) -> kappe::input::UncertaintyTable {
+    toml::from_str(table).unwrap()
+}
+
+fn uncertain(d: &Design, table: &str) -> Design {
+    let mut d = d.clone();
+    let t = table_of(table);
+    t.model(&d).unwrap();
+    d.uncertainty = Some(t);
+    d
+}
+
+/// A strength parameter without a strength model, one of the other strength form, and the
+/// print speed without a time model: named errors that say what is allowed.
+#[test]
+fn strength_parameters_and_the_speed_are_named_errors() {
+    let lognormal = "{ dist = \"lognormal\", cov = 0.1 }";
+    let cases = [
+        (
+            small(),
+            format!("\"material.time.compressive_strength\" = {lognormal}\n"),
+            "strength model",
+        ),
+        (
+            green_cap(0.0, 5.0e3, 0.0, 0.0),
+            format!("\"material.time.cohesion\" = {lognormal}\n"),
+            "compressive_strength (uniaxial)",
+        ),
+        (
+            small(),
+            format!("\"print.print_speed\" = {lognormal}\n"),
+            "time model",
+        ),
+        (
+            green_cap(0.0, 5.0e3, 0.0, 0.0),
+            "\"print.print_speed\" = { dist = \"normal\", cov = 0.1 }\n".to_owned(),
+            "positive",
+        ),
+    ];
+    for (d, table, needle) in cases {
+        let e = table_of(&table).model(&d).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, kappe::DesignError::Uncertainty { .. }), "{msg}");
+        assert!(msg.contains(needle), "`{needle}` not in: {msg}");
+        assert!(msg.contains("uncertainty."), "no field named: {msg}");
+    }
+}
+
+/// Closed form: with a strength constant in time (rate 0, φ = 0) and f₀ lognormal alone, every
+/// layer's utilisation is u₀·f₀⁰/f₀, so the state's strength β is exactly
+/// (−ln u₀ − ζ²/2)/ζ, ζ² = ln(1 + cov²), u₀ the deterministic verdict's utilisation. FORM of a
+/// limit state linear in ln f₀ converges in one step; 1e-6 absolute covers its convergence
+/// test (|G| ≤ 1e-6 relative) and the static solves' round-off (≤ 1e-10 relative in u₀).
+#[test]
+fn strength_beta_of_a_constant_strength_is_the_closed_form() {
+    // f₀ = 10 kPa first, then scaled so the worst state's u₀ is 0.7 (u ∝ 1/f₀ exactly).
+    let probe = green_cap(0.0, 1.0e4, 0.0, 0.0);
+    let out = run(&probe, &Options::of(&probe), &no_progress).unwrap();
+    let u = out
+        .analysis
+        .as_ref()
+        .unwrap()
+        .states
+        .iter()
+        .filter_map(|s| s.strength_utilisation)
+        .fold(0.0, f64::max);
+    assert!(u > 0.0, "no strength check in the probe run");
+    let d = green_cap(0.0, 1.0e4 * u / 0.7, 0.0, 0.0);
+    let cov: f64 = 0.1;
+    let d = uncertain(
+        &d,
+        &format!(
+            "\"material.time.compressive_strength\" = {{ dist = \"lognormal\", cov = {cov} }}\n"
+        ),
+    );
+    let out = run(&d, &Options::of(&d), &no_progress).unwrap();
+    let r = out.reliability.as_ref().unwrap();
+    let zeta = (1.0 + cov * cov).ln().sqrt();
+    let mut checked = 0;
+    for s in &out.analysis.as_ref().unwrap().states {
+        let Some(u0) = s.strength_utilisation else {
+            continue;
+        };
+        let state = r.states.iter().find(|x| x.index == s.index).unwrap();
+        let beta = state.beta_by_check["strength"];
+        let exact = (-u0.ln() - 0.5 * zeta * zeta) / zeta;
+        assert!(
+            (beta - exact).abs() < 1e-6,
+            "state {}: FORM β {beta} vs closed form {exact} (u₀ {u0})",
+            s.index
+        );
+        checked += 1;
+    }
+    assert!(checked > 0, "no state with a strength β");
+}
+
+/// The layer-by-layer strength and sliding utilisations at a trial point of γ, f₀, ḟ, φ and the
+/// print speed against the deterministic verdict re-run with those values (E constant in time,
+/// so the stresses do not depend on the ages and the reduction is exact: the stresses scale
+/// with γ, each layer's age with v₀/v). 1e-8 relative: two static solves of load vectors that
+/// differ by a factor, and ages summed in a different order, round-off only. Then the whole
+/// run with the five uncertain: a finite β with strength and sliding components.
+#[test]
+fn strength_and_speed_limit_states_match_a_rerun() {
+    // f₀ = 30 kPa: the last state passes (u₀ ≈ 0.65) with a finite β.
+    let f0 = 3.0e4;
+    let d = green_cap(0.0, f0, 3.0, 20.0);
+    let table = "\"material.specific_weight\" = { dist = \"normal\", cov = 0.03 }\n\
+                 \"material.time.compressive_strength\" = { dist = \"lognormal\", cov = 0.15 }\n\
+                 \"material.time.compressive_strength_rate\" = { dist = \"lognormal\", cov = 0.2 }\n\
+                 \"material.time.friction_angle_deg\" = { dist = \"lognormal\", cov = 0.1 }\n\
+                 \"print.print_speed\" = { dist = \"lognormal\", cov = 0.1 }\n";
+    let du = uncertain(&d, table);
+    let cap = design_cap(&du, kappe::Context::default()).unwrap();
+    let (model, _, v) = prepare(&cap).unwrap().unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
+    let time = du.time_model().unwrap();
+    let last = cap.states.len() - 1;
+    let field = GreenField::solve(&cap, &du.analysis, &green.schedule, last)
+        .unwrap()
+        .unwrap();
+    // Variables in name order.
+    let names: Vec<&str> = model.variables().iter().map(|v| v.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "material.specific_weight",
+            "material.time.compressive_strength",
+            "material.time.compressive_strength_rate",
+            "material.time.friction_angle_deg",
+            "print.print_speed"
+        ]
+    );
+    let m = &d.material;
+    let trial = [
+        m.specific_weight * 1.04,
+        f0 * 0.9,
+        3.0 * 1.2,
+        23.0,
+        d.print.print_speed * 1.3,
+    ];
+    let verdict = |x: &[f64]| {
+        let mut e = green_cap(0.0, x[1], x[2], x[3]);
+        e.material.specific_weight = x[0];
+        e.print.print_speed = x[4];
+        let out = run(&e, &Options::of(&e), &no_progress).unwrap();
+        let s = out.analysis.unwrap().states.last().cloned().unwrap();
+        (
+            s.strength_utilisation.unwrap(),
+            s.sliding_utilisation.unwrap(),
+        )
+    };
+    let nominal = [m.specific_weight, f0, 3.0, 20.0, d.print.print_speed];
+    for x in [nominal, trial] {
+        let (st, sl) = verdict(&x);
+        let ours = (
+            field.utilisation(v, &time, &x, None, false),
+            field.utilisation(v, &time, &x, None, true),
+        );
+        assert!(
+            (ours.0 / st - 1.0).abs() < 1e-8 && (ours.1 / sl - 1.0).abs() < 1e-8,
+            "at {x:?}: strength {} vs re-run {st}, sliding {} vs {sl}",
+            ours.0,
+            ours.1
+        );
+    }
+    let out = run(&du, &Options::of(&du), &no_progress).unwrap();
+    let r = out.reliability.as_ref().unwrap();
+    let s = r.states.iter().find(|s| s.index == last).unwrap();
+    assert!(r.beta.is_finite() && s.beta.is_finite(), "{r:?}");
+    for k in ["strength", "sliding", "buckling"] {
+        assert!(s.beta_by_check.contains_key(k), "no {k} in {s:?}");
+    }
+}
+
+/// The print speed in the buckling check: ∂λ/∂s (s = v₀/v scales every print duration) from
+/// the eigenvalue sensitivity against central differences of re-solves (step 1e-4 of s, the
+/// tolerance 1e-5 as for E₀ and Ė), and the scaled ages against the schedule of the design
+/// printed at v = 1.25 v₀ (relative 1e-9 on λ: the same shell, ages summed in another order).
+#[test]
+fn print_speed_sensitivity_of_a_cap_state() {
+    use kappe::analysis::time_state_blf_ages;
+    let mut d = small();
+    d.material.time = Some(kappe::input::TimeModelSpec {
+        model: Some(kappe::input::TimeLaw::Linear),
+        youngs_modulus: Some(2.0e6),
+        youngs_modulus_rate: Some(2.0e4),
+        ..Default::default()
+    });
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
+    let time = d.time_model().unwrap();
+    let last = cap.states.len() - 1;
+    let at = |s: f64| {
+        let (ages, print) = scaled_ages(&green.schedule, last, s);
+        time_state_blf_ages(&cap, &d.analysis, &ages, &print, &time, last, 1e-12)
+            .unwrap()
+            .unwrap()
+    };
+    let (lambda, dl) = at(1.0);
+    let h = 1e-4;
+    let fd = (at(1.0 + h).0 - at(1.0 - h).0) / (2.0 * h);
+    assert!(
+        (dl[2] / fd - 1.0).abs() < 1e-5,
+        "∂λ/∂s {} vs central difference {fd} (λ {lambda})",
+        dl[2]
+    );
+    let mut fast = d.clone();
+    fast.print.print_speed *= 1.25;
+    let cap2 = design_cap(&fast, kappe::Context::default()).unwrap();
+    let sched = kappe::analysis::CapGreen::new(&cap2).unwrap().schedule;
+    let direct = kappe::analysis::time_state_blf(&cap2, &d.analysis, &sched, &time, last, 1e-12)
+        .unwrap()
+        .unwrap()
+        .0;
+    let scaled = at(1.0 / 1.25).0;
+    assert!(
+        (scaled / direct - 1.0).abs() < 1e-9,
+        "scaled ages λ {scaled} vs the faster print's schedule {direct}"
     );
 }

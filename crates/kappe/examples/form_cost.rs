@@ -1,0 +1,106 @@
+//! The cost of the reliability analysis against the deterministic analysis (issue 24: FORM of
+//! every state ≤ 3× the deterministic analysis), on a cap whose time-model parameters are
+//! uncertain, printed as a table:
+//! `cargo run --release -p kappe --example form_cost [repeats]`.
+//!
+//! The cap is study No. 14's of the reliability tests (the small cap, 0.15 m long, printed at
+//! 0.01 m/s: 44 states over 57 min; E(t) = 1.3 MPa + 400 Pa/s·t; every state analysed, every
+//! 8th row in the shell, as the CLI test's `DRIFTING_CAP`) with E₀ (lognormal, cov 0.15),
+//! Ė (lognormal, cov 0.3) and γ (normal, cov 0.05) uncertain and E₀ drifting −20 %/h, as stop
+//! 31 measured it (5–8× by CPU time then). Its buckling components re-solve the state's shell
+//! at every FORM iterate, with the exact eigenvalue sensitivity for the gradient. A second row
+//! has the strength parameters and the print speed uncertain as well (a strength model
+//! f(t) = 30 kPa + 3 Pa/s·t, φ = 0).
+//!
+//! Per row: the deterministic analysis (`analysis_timings_s.total`, wall) and the CPU time of
+//! the whole nominal run, then the reliability of every state and of the print (the function
+//! the run calls), wall and CPU, and the ratios; runs alternate (deterministic, reliability)
+//! `repeats` times (default 2) and the medians are printed, with the load average (the machine
+//! is shared).
+
+use std::time::Instant;
+
+#[path = "common/measure.rs"]
+mod measure;
+use measure::{cpu_seconds, load_average};
+
+use kappe::{Design, Options, design_cap, no_progress, run};
+
+fn cap(strength: bool) -> Result<Design, Box<dyn std::error::Error>> {
+    let strength_model = if strength {
+        "compressive_strength = 3.0e4\ncompressive_strength_rate = 3.0\n"
+    } else {
+        ""
+    };
+    let strength_vars = if strength {
+        "\"material.time.compressive_strength\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         \"material.time.compressive_strength_rate\" = { dist = \"lognormal\", cov = 0.2 }\n\
+         \"print.print_speed\" = { dist = \"lognormal\", cov = 0.1 }\n"
+    } else {
+        ""
+    };
+    let text = format!(
+        "name = \"study14\"\n[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\n\
+         print_speed = 0.01\n[robot]\nenabled = false\n[analysis]\nrow_stride = 8\n\
+         [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\n\
+         youngs_modulus_rate = 400.0\n{strength_model}\
+         [uncertainty]\n\"material.time.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}\n\
+         \"material.time.youngs_modulus_rate\" = {{ dist = \"lognormal\", cov = 0.3 }}\n\
+         \"material.specific_weight\" = {{ dist = \"normal\", cov = 0.05 }}\n{strength_vars}\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = {{ percent_per_hour = -20.0 }}\n"
+    );
+    Ok(Design::from_toml_str(&text)?)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let repeats: usize = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2);
+    println!(
+        "row | det. analysis wall s | nominal run CPU s | reliability wall s | CPU s | \
+         ratio wall | ratio CPU | components | print β | load"
+    );
+    for (name, strength) in [("time parameters", false), ("+ strength, speed", true)] {
+        let d = cap(strength)?;
+        let mut nominal = d.clone();
+        nominal.uncertainty = None;
+        let cap = design_cap(&d, kappe::Context::default())?;
+        let (mut dw, mut dc, mut rw, mut rc) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut last = None;
+        for _ in 0..repeats {
+            let c0 = cpu_seconds().unwrap_or(f64::NAN);
+            let out = run(&nominal, &Options::of(&nominal), &no_progress)?;
+            dc.push(cpu_seconds().unwrap_or(f64::NAN) - c0);
+            let analysis = out.analysis.as_ref().ok_or("no analysis")?;
+            dw.push(analysis.timings.total);
+            let (t0, c0) = (Instant::now(), cpu_seconds().unwrap_or(f64::NAN));
+            let r = kappe::analysis::reliability(&cap, analysis, &out.schedule)?
+                .ok_or("no reliability")?;
+            rw.push(t0.elapsed().as_secs_f64());
+            rc.push(cpu_seconds().unwrap_or(f64::NAN) - c0);
+            last = Some(r);
+        }
+        let r = last.ok_or("no run")?;
+        let (dw, dc, rw, rc) = (
+            median(&mut dw),
+            median(&mut dc),
+            median(&mut rw),
+            median(&mut rc),
+        );
+        println!(
+            "{name} | {dw:.2} | {dc:.2} | {rw:.2} | {rc:.2} | {:.2} | {:.2} | {} | {:.2} | {}",
+            rw / dw,
+            rc / dc,
+            r.components,
+            r.beta,
+            load_average()
+        );
+    }
+    Ok(())
+}
