@@ -38,7 +38,11 @@ if ! "$TOOLS/bin/wasm-bindgen" --version 2>/dev/null | grep -q " $WASM_BINDGEN_V
 fi
 
 # Debian's compiler and cargo for the wasm build only (the rest of the workspace: rustup stable).
+# simd128: faer's kernels (pulp, gemm) take their 128-bit WebAssembly SIMD paths instead of the
+# scalar fallback in the buckling workers; Chromium ≥ 91, Firefox ≥ 89 and Safari ≥ 16.4 run it.
+# std is rebuilt with the same flag (-Zbuild-std).
 env PATH="/usr/bin:$PATH" RUSTC=/usr/bin/rustc RUSTDOC=/usr/bin/rustdoc RUSTC_BOOTSTRAP=1 \
+  RUSTFLAGS="-C target-feature=+simd128" \
   CARGO_TARGET_DIR="$TARGET_DIR" CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_LINKER=wasm-ld \
   /usr/bin/cargo build --release -p kappe-designer --target wasm32-unknown-unknown \
   -Zbuild-std=std,panic_abort
