@@ -586,6 +586,7 @@ pub fn check_layers_warm(
                 }),
                 strength: c.strength && nl.material,
                 sliding: c.sliding && nl.material,
+                fast_path: false,
             };
             let shape = mode.clone().unwrap_or_default();
             // docs/collapse.md §8: the path from the as-printed geometry.
