@@ -19,10 +19,10 @@ use std::collections::HashMap;
 use serde::Serialize;
 
 use crate::analysis::shell::{ShellMaterial, StateShell, state_shell};
-use crate::analysis::stress::{ElementStress, element_stresses};
 use crate::form::forces::{Sections2D, split_state_forces};
 use crate::form::frame::V3;
 use crate::form::states::State;
+use crate::form::stresses::{ElementStress, element_stresses};
 use crate::input::error::DesignError;
 
 /// What the shell carries of one state, and how well.

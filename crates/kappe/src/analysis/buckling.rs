@@ -9,10 +9,10 @@ use serde::Serialize;
 use crate::analysis::asprinted::Increment;
 use crate::analysis::bending::BendingSummary;
 use crate::analysis::shell::{NoShell, ShellMaterial, StateShell, state_shell};
-use crate::analysis::stress::ElementStress;
 use crate::form::cap::Cap;
 use crate::form::forces::Sections2D;
 use crate::form::states::State;
+use crate::form::stresses::ElementStress;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 

@@ -13,9 +13,9 @@ use super::buckling::{
     BucklingRequest, BucklingStatus, ModeGuess, NetworkMode, StateBuckling, state_buckling,
     state_material,
 };
-use super::stress::{STRESS_REL_TOL, StressExtremes};
 use crate::form::cap::Cap;
 use crate::form::states::build_state;
+use crate::form::stresses::{STRESS_REL_TOL, StressExtremes};
 use crate::input::analysis::AnalysisOptions;
 use crate::input::context::Context;
 use crate::input::error::DesignError;

@@ -42,7 +42,6 @@ pub(crate) mod graded;
 pub(crate) mod green;
 pub(crate) mod reliability;
 pub(crate) mod shell;
-pub(crate) mod stress;
 
 pub use crate::form::overhang::layer_overhangs;
 pub use crate::form::stresses::{ElementKind, ElementStress, STRESS_REL_TOL, element_stresses};

@@ -478,7 +478,7 @@ fn state_checks(
         m.max(s.max_compression_stress_pa.abs())
             .max(s.max_tension_stress_pa.abs())
     });
-    let stol = super::stress::STRESS_REL_TOL * scale;
+    let stol = crate::form::stresses::STRESS_REL_TOL * scale;
     let mut out = Vec::with_capacity(analysis.states.len());
     for s in &analysis.states {
         let t_hours = schedule.layers.get(s.index).map_or(0.0, |l| l.end_s) / 3600.0;
