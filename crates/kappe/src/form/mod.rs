@@ -26,5 +26,5 @@ pub use forces::{Sections2D, state_forces};
 pub use frame::{LayerFrame, V3};
 pub use overhang::{layer_overhangs, measured_overhangs};
 pub use section::{NodeKind, Sections, build_sections_with_end};
-pub use states::{Role, build_state};
+pub use states::{Role, State, build_state};
 pub use stresses::{ElementKind, ElementStress, STRESS_REL_TOL, StressExtremes, element_stresses};

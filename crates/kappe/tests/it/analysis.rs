@@ -7,6 +7,7 @@
 //! final-state BLF changes by < 0.3 % between 1 and 4 layers per row, and the designs tested
 //! with 8 are far from their limits.
 
+use crate::common::single_state_buckling;
 use kappe::analysis::state_shell;
 use kappe::analysis::{
     Ageing, AnalysisOptions, BucklingStatus, ElementKind, StateSelection, analyze,
@@ -314,35 +315,11 @@ fn blf_scales_with_e_and_ageing_is_bounded() {
     let last = c.states.len() - 1;
     let state = build_state(&c.sections, &c.frame, 0.0, last).unwrap();
     let o = AnalysisOptions::default();
-    let b1 = state_buckling(
-        &state,
-        &state_material(
-            &c,
-            &o,
-            last,
-            Some(&kappe::analysis::CapGreen::new(&c).unwrap()),
-        ),
-        &o.with_split_at_most(2),
-        &Default::default(),
-    )
-    .unwrap()
-    .buckling;
+    let b1 = single_state_buckling(&c, &state, &o, last);
     let mut d2 = d.clone();
     d2.material.youngs_modulus *= 2.0;
     let c2 = cap(&d2);
-    let b2 = state_buckling(
-        &state,
-        &state_material(
-            &c2,
-            &o,
-            last,
-            Some(&kappe::analysis::CapGreen::new(&c2).unwrap()),
-        ),
-        &o.with_split_at_most(2),
-        &Default::default(),
-    )
-    .unwrap()
-    .buckling;
+    let b2 = single_state_buckling(&c2, &state, &o, last);
     // Linear buckling under dead load: BLF ∝ E exactly (buckling.md A11); 1e-6 covers the
     // Lanczos tolerance of 1e-8 on μ.
     assert!((b2.factors[0] / b1.factors[0] - 2.0).abs() < 1e-6);

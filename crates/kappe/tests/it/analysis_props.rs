@@ -2,8 +2,9 @@
 //! grows and rises with the shell thickness roughly as lw². Reduced designs (short centre section,
 //! coarse sampling, 4 layers per mesh row) keep the unoptimised test build quick.
 
+use crate::common::single_state_buckling;
 use kappe::Design;
-use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
+use kappe::analysis::AnalysisOptions;
 use kappe::form::build_state;
 
 fn small() -> Design {
@@ -21,20 +22,7 @@ fn final_blf(d: &Design) -> f64 {
         row_stride: 4,
         ..AnalysisOptions::default()
     };
-    state_buckling(
-        &state,
-        &state_material(
-            &cap,
-            &o,
-            last,
-            Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
-        ),
-        &o.with_split_at_most(2),
-        &Default::default(),
-    )
-    .unwrap()
-    .buckling
-    .factors[0]
+    single_state_buckling(&cap, &state, &o, last).factors[0]
 }
 
 /// Geometrically similar caps (rise = span/4, same thickness): a longer span is more slender, so

@@ -9,6 +9,7 @@ mod buildability_reliability;
 mod cap;
 mod ceiling;
 mod collapse;
+mod common;
 mod corrugation;
 mod ends;
 mod floors;

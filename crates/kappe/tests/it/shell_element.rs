@@ -1,7 +1,8 @@
 //! The shell element of the cap analysis (issue 17): the shear-deformable ANDES+DKMT by
 //! default, the Kirchhoff CST+DKT selectable in the design file's `[analysis]`.
 
-use kappe::analysis::{AnalysisOptions, state_buckling, state_material};
+use crate::common::single_state_buckling;
+use kappe::analysis::AnalysisOptions;
 use kappe::form::build_state;
 use kappe_fe::ElementKind;
 
@@ -43,20 +44,7 @@ fn final_state_blf_drops_by_the_shear_share() {
             element,
             ..AnalysisOptions::default()
         };
-        state_buckling(
-            &state,
-            &state_material(
-                &cap,
-                &o,
-                last,
-                Some(&kappe::analysis::CapGreen::new(&cap).unwrap()),
-            ),
-            &o.with_split_at_most(2),
-            &Default::default(),
-        )
-        .unwrap()
-        .buckling
-        .factors[0]
+        single_state_buckling(&cap, &state, &o, last).factors[0]
     };
     let (dkt, dkmt) = (blf(ElementKind::CstDkt), blf(ElementKind::AndesDkmt));
     let change = dkmt / dkt - 1.0;
