@@ -797,14 +797,7 @@ fn plan_with_lead(
             tr.push(lead + offsets[o][k] - y0);
             r += 1;
         }
-        layers_out.push(LayerPlan {
-            layer: layer.layer,
-            waypoints: wps,
-            cost,
-            min_clearance: min_c,
-            max_speed_ratio: 0.0,
-            wait: 0.0,
-        });
+        layers_out.push(LayerPlan::untimed(layer.layer, wps, cost, min_c));
         travel.push(tr);
     }
     let station = Station {

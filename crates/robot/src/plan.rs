@@ -51,6 +51,26 @@ pub struct LayerPlan {
     pub wait: f64,
 }
 
+impl LayerPlan {
+    /// A layer as the planners' joint search leaves it: its timing (the speed ratio and the
+    /// wait) is not known until the timing pass runs over the whole plan.
+    pub(crate) fn untimed(
+        layer: i64,
+        waypoints: Vec<Waypoint>,
+        cost: f64,
+        min_clearance: f64,
+    ) -> LayerPlan {
+        LayerPlan {
+            layer,
+            waypoints,
+            cost,
+            min_clearance,
+            max_speed_ratio: 0.0,
+            wait: 0.0,
+        }
+    }
+}
+
 /// All layers printed from one base pose.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Station {

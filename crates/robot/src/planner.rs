@@ -718,14 +718,7 @@ pub(crate) fn plan_station_cached(
             r += 1;
         }
         prev_q = wps.last().map(|w| w.q);
-        layers_out.push(LayerPlan {
-            layer: layer.layer,
-            waypoints: wps,
-            cost,
-            min_clearance: min_c,
-            max_speed_ratio: 0.0,
-            wait: 0.0,
-        });
+        layers_out.push(LayerPlan::untimed(layer.layer, wps, cost, min_c));
     }
     Ok(Station {
         world_from_base: world_from_base.to_mat4(),

@@ -3,7 +3,7 @@
 //! path in code (not in a comment, not in a `#[cfg(test)] mod tests` block) is an import; a
 //! root re-export (`crate::Design`, `crate::run`, …) counts as the module that defines it.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The floors, bottom first (the order of `lib.rs`'s table).
@@ -193,27 +193,109 @@ fn cycle(graph: &[(String, BTreeSet<String>)]) -> Option<Vec<String>> {
     None
 }
 
-/// The import graph of one crate's top-level modules (`crate::m` paths in code, as above; a
-/// root re-export is not followed, so it cannot hide a cycle it would close only through the
-/// root).
+/// A crate's code without comment lines and without its unit-test module.
+fn code_of(text: &str) -> String {
+    let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
+    code.lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The leading identifier of `s` (after spaces).
+fn ident(s: &str) -> String {
+    s.trim_start()
+        .chars()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect()
+}
+
+/// The first path segments `code` names through `crate::`: `crate::m::x` gives `m`, a group
+/// `crate::{a::x, b::{y, z}, C}` gives `a`, `b` and `C` (a group may span lines).
+fn crate_paths(code: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (i, _) in code.match_indices("crate::") {
+        let rest = &code[i + 7..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let (mut depth, mut start) = (0usize, 0usize);
+            for (k, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        out.push(ident(&group[start..k]));
+                        break;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        out.push(ident(&group[start..k]));
+                        start = k + 1;
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            out.push(ident(rest));
+        }
+    }
+    out.retain(|m| !m.is_empty());
+    out
+}
+
+/// The crate root's re-exports: each name `pub use m::…` makes available at the root, mapped
+/// to its module `m` (so `crate::Name` counts as an import of `m`).
+fn root_reexports(src: &Path, names: &BTreeSet<String>) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    for root in ["lib.rs", "main.rs"] {
+        let Ok(text) = std::fs::read_to_string(src.join(root)) else {
+            continue;
+        };
+        for stmt in code_of(&text).split(';') {
+            let Some(path) = stmt.trim_start().strip_prefix("pub use ") else {
+                continue;
+            };
+            let path = path.trim_start();
+            let path = path
+                .strip_prefix("crate::")
+                .or_else(|| path.strip_prefix("self::"))
+                .unwrap_or(path);
+            let module = ident(path);
+            if !names.contains(&module) {
+                continue;
+            }
+            let items = &path[module.len()..];
+            for word in items.split(|c: char| !(c.is_alphanumeric() || c == '_')) {
+                if !word.is_empty() && word != "as" && word != "self" {
+                    out.entry(word.to_string())
+                        .or_insert_with(|| module.clone());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The import graph of one crate's top-level modules: the `crate::` paths in code (groups
+/// included), a root re-export followed to the module it comes from (a cycle closed only
+/// through the root is still a cycle).
 fn crate_graph(src: &Path) -> Vec<(String, BTreeSet<String>)> {
     let mods = modules(src);
     let names: BTreeSet<String> = mods.iter().map(|(n, _)| n.clone()).collect();
+    let root = root_reexports(src, &names);
     mods.into_iter()
         .map(|(name, files)| {
             let mut deps = BTreeSet::new();
             for f in files {
                 let text = std::fs::read_to_string(&f).unwrap();
-                let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
-                for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
-                    for (i, _) in line.match_indices("crate::") {
-                        let m: String = line[i + 7..]
-                            .chars()
-                            .take_while(|c| c.is_alphanumeric() || *c == '_')
-                            .collect();
-                        if m != name && names.contains(&m) {
-                            deps.insert(m);
-                        }
+                for m in crate_paths(&code_of(&text)) {
+                    let m = if names.contains(&m) {
+                        Some(m)
+                    } else {
+                        root.get(&m).cloned()
+                    };
+                    if let Some(m) = m
+                        && m != name
+                    {
+                        deps.insert(m);
                     }
                 }
             }
@@ -266,4 +348,23 @@ fn the_cycle_search_finds_a_cycle_and_only_a_cycle() {
     assert_eq!(cycle(&diamond), None);
     let ring = g(&[("a", &["b"]), ("b", &["c"]), ("c", &["a"])]);
     assert_eq!(cycle(&ring).map(|c| c.len()), Some(3));
+}
+
+#[test]
+fn the_import_scan_follows_groups_and_root_reexports() {
+    let code = "use crate::{a::x,\n    b::{y, z}, Root};\nfn f() { crate::c::g(); }";
+    assert_eq!(crate_paths(code), ["a", "b", "Root", "c"]);
+    let dir = std::env::temp_dir().join(format!("kappe-floors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("lib.rs"),
+        "mod a;\npub use a::{Root, helper as h};\npub use crate::b::Other;\n",
+    )
+    .unwrap();
+    let names: BTreeSet<String> = ["a", "b"].iter().map(|s| s.to_string()).collect();
+    let root = root_reexports(&dir, &names);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(root.get("Root").map(String::as_str), Some("a"));
+    assert_eq!(root.get("helper").map(String::as_str), Some("a"));
+    assert_eq!(root.get("Other").map(String::as_str), Some("b"));
 }
