@@ -173,7 +173,11 @@
   const NWORKERS = Math.max(1, Math.min(2, navigator.hardwareConcurrency || 2));
   const workerUrl = URL.createObjectURL(new Blob([GLUE, '\n', WORKER_SRC], { type: 'text/javascript' }));
   let pool = [];
+  // Jobs: { run: [state indices], max_split } (1: the first pass; more: the mesh-error pass).
   let queue = [];
+  // The mesh-error solves handed out for the current design ("state:split"): the pass names
+  // what it still lacks, so a batch shrinks as its results come in and must not be sent twice.
+  let sent = new Set();
 
   function spawn() {
     const w = new Worker(workerUrl);
@@ -196,14 +200,29 @@
       return w;
     });
     while (pool.length < NWORKERS) pool.push(spawn());
-    queue = res.runs.map((r) => r.slice());
+    queue = res.runs.map((r) => ({ run: r.slice(), max_split: 1 }));
+    sent = new Set();
     pool.forEach(feed);
     if (res.runs.length === 0) finished();
   }
   function feed(w) {
     if (w.busy || !queue.length || !current) return;
     w.busy = true;
-    w.postMessage({ generation: current.generation, text: current.text, run: queue.shift() });
+    const job = queue.shift();
+    w.postMessage({ generation: current.generation, text: current.text, run: job.run, max_split: job.max_split });
+  }
+  // Once every first-pass factor is in, the mesh-error pass (kappe's `converge_fe`, replayed on
+  // this thread at every result) asks for the split solves it needs next, batch by batch: each
+  // state is one job, largest first, so both workers stay busy (longest processing time first).
+  function refine(batch) {
+    if (!batch) return;
+    const todo = batch.states.filter((i) => !sent.has(i + ':' + batch.max_split));
+    todo.sort((a, b) => b - a);
+    for (const i of todo) {
+      sent.add(i + ':' + batch.max_split);
+      queue.push({ run: [i], max_split: batch.max_split });
+    }
+    pool.forEach(feed);
   }
   function onWorker(w, msg) {
     if (msg.done !== undefined) {
@@ -222,6 +241,7 @@
       return;
     }
     drawReport();
+    refine(report.refine);
     if (report.complete) finished();
   }
   function finished() {
@@ -245,7 +265,8 @@
       v.textContent = r.ok ? 'PASS' : 'FAIL';
       v.className = 'verdict ' + (r.ok ? 'pass' : 'fail');
     } else {
-      v.textContent = (r.ok_so_far ? 'passing so far' : 'FAIL') + ' (buckling ' + r.states_done + ' / ' + r.states_total + ')';
+      const what = r.refine ? 'mesh error, ' + r.refine.states.length + ' states left in this round' : 'buckling ' + r.states_done + ' / ' + r.states_total;
+      v.textContent = (r.ok_so_far ? 'passing so far' : 'FAIL') + ' (' + what + ')';
       v.className = 'verdict ' + (r.ok_so_far ? 'pending' : 'fail');
     }
     $('progress').value = r.states_total ? r.states_done / r.states_total : 1;

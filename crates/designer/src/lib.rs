@@ -26,8 +26,10 @@ use std::collections::BTreeMap;
 
 use kappe::analysis::WorstElement;
 use kappe::analysis::{BucklingStatus, ModeGuess, StateBuckling};
+use kappe::analysis::{RefineBatch, RefineSolves};
 use kappe::analysis::{StateFe, analysis_green, fe_runs, state_fe};
 use kappe::{Cap, Design, DesignError};
+use kappe_fe::{ConvergedFactor, MeshLevel};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use wasm_bindgen::prelude::*;
@@ -80,6 +82,64 @@ pub struct FeWire {
     pub shell_nodes: usize,
     /// [`StateFe::green`]: (strength, sliding) worst elements.
     pub green: Option<(Option<WorstWire>, Option<WorstWire>)>,
+    /// The `blf_max_split` the state was solved with: 1 for the first pass (print-layer mesh),
+    /// more for a solve of the mesh-error pass ([`kappe::analysis::RefineBatch`]).
+    #[serde(default = "first_pass")]
+    pub max_split: usize,
+    /// [`StateBuckling::convergence`] (a solve of the mesh-error pass; `None` in the first pass).
+    #[serde(default)]
+    pub convergence: Option<ConvergedWire>,
+}
+
+fn first_pass() -> usize {
+    1
+}
+
+/// [`ConvergedFactor`] on the wire: JSON has no infinity, so an unbounded error is `null`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConvergedWire {
+    levels: Vec<(usize, f64, usize, usize)>,
+    extrapolated: f64,
+    upper: f64,
+    error: Option<f64>,
+    converged: bool,
+}
+
+impl From<&ConvergedFactor> for ConvergedWire {
+    fn from(c: &ConvergedFactor) -> Self {
+        ConvergedWire {
+            levels: c
+                .levels
+                .iter()
+                .map(|l| (l.split, l.factor, l.n_free_dofs, l.steps))
+                .collect(),
+            extrapolated: c.extrapolated,
+            upper: c.upper,
+            error: c.error.is_finite().then_some(c.error),
+            converged: c.converged,
+        }
+    }
+}
+
+impl From<ConvergedWire> for ConvergedFactor {
+    fn from(w: ConvergedWire) -> Self {
+        ConvergedFactor {
+            levels: w
+                .levels
+                .into_iter()
+                .map(|(split, factor, n_free_dofs, steps)| MeshLevel {
+                    split,
+                    factor,
+                    n_free_dofs,
+                    steps,
+                })
+                .collect(),
+            extrapolated: w.extrapolated,
+            upper: w.upper,
+            error: w.error.unwrap_or(f64::INFINITY),
+            converged: w.converged,
+        }
+    }
 }
 
 /// [`WorstElement`] on the wire.
@@ -116,8 +176,9 @@ impl From<WorstWire> for WorstElement {
     }
 }
 
-impl From<&StateFe> for FeWire {
-    fn from(f: &StateFe) -> Self {
+impl FeWire {
+    /// `f` solved with `blf_max_split = max_split`.
+    fn of(f: &StateFe, max_split: usize) -> Self {
         FeWire {
             state: f.state,
             status: f.buckling.status,
@@ -131,6 +192,8 @@ impl From<&StateFe> for FeWire {
                     l.as_ref().map(WorstWire::from),
                 )
             }),
+            max_split,
+            convergence: f.buckling.convergence.as_ref().map(ConvergedWire::from),
         }
     }
 }
@@ -145,9 +208,10 @@ impl From<FeWire> for StateFe {
                 location: w.location,
                 mechanism: w.mechanism,
                 shell_nodes: w.shell_nodes,
-                // A worker's result is the first pass (`state_fe`): the mesh error is estimated
-                // afterwards over all states (`converge_fe`, in `kappe::analysis::analyze` with the results given).
-                convergence: None,
+                // A first-pass result has none: the mesh error is estimated afterwards over all
+                // states (`converge_fe`, in `kappe::analysis::analyze` with the results given),
+                // from the mesh-error solves the workers make when it asks for them.
+                convergence: w.convergence.map(ConvergedFactor::from),
             },
             // The mode shape is not drawn by the designer (it is large); it enters no check.
             mode: Vec::new(),
@@ -248,6 +312,8 @@ pub struct SessionCore {
     cap: Option<Cap>,
     runs: Vec<Vec<usize>>,
     fe: BTreeMap<usize, StateFe>,
+    /// The mesh-error pass's solves so far (the workers make them when the pass asks).
+    refined: RefineSolves,
     generation: u64,
 }
 
@@ -265,6 +331,7 @@ impl SessionCore {
             cap: None,
             runs: Vec::new(),
             fe: BTreeMap::new(),
+            refined: RefineSolves::new(),
             generation: 0,
         }
     }
@@ -286,10 +353,12 @@ impl SessionCore {
             .map_err(|e| FieldError::of(&e))?;
         let runs = fe_runs(&design.analysis, cap.states.len());
         // The quick pass must succeed before the design is taken (e.g. a bad [schedule]).
-        let outcome = evaluate(&cap, &BTreeMap::new()).map_err(|e| FieldError::of(&e))?;
+        let outcome = evaluate(&cap, &BTreeMap::new(), &RefineSolves::new())
+            .map_err(|e| FieldError::of(&e))?;
         self.text = text.to_string();
         self.runs = runs;
         self.fe.clear();
+        self.refined.clear();
         self.generation += 1;
         let view = view(&cap);
         let report = report(&outcome, &self.runs);
@@ -329,17 +398,29 @@ impl SessionCore {
                 message: format!("worker results: {e}"),
             })?;
             for w in wires {
-                self.fe.insert(w.state, StateFe::from(w));
+                match w.max_split {
+                    0 | 1 => {
+                        self.fe.insert(w.state, StateFe::from(w));
+                    }
+                    split => {
+                        self.refined.insert((w.state, split), StateFe::from(w));
+                    }
+                }
             }
         }
-        let outcome = evaluate(cap, &self.fe).map_err(|e| FieldError::of(&e))?;
+        let outcome = evaluate(cap, &self.fe, &self.refined).map_err(|e| FieldError::of(&e))?;
         Ok(report(&outcome, &self.runs))
     }
 }
 
-/// The verdict of `cap` with the buckling results `fe` so far: [`kappe::run::evaluate`]
-/// with the design's own analysis options and no robot plan.
-fn evaluate(cap: &Cap, fe: &BTreeMap<usize, StateFe>) -> Result<kappe::Outcome, DesignError> {
+/// The verdict of `cap` with the buckling results so far (`fe`: first pass, `refined`: the
+/// mesh-error pass's solves): [`kappe::run::evaluate`] with the design's own analysis options
+/// and no robot plan.
+fn evaluate(
+    cap: &Cap,
+    fe: &BTreeMap<usize, StateFe>,
+    refined: &RefineSolves,
+) -> Result<kappe::Outcome, DesignError> {
     let options = kappe::Options {
         analysis: Some(cap.design.analysis.clone()),
         robot: false,
@@ -348,7 +429,10 @@ fn evaluate(cap: &Cap, fe: &BTreeMap<usize, StateFe>) -> Result<kappe::Outcome, 
     kappe::run::evaluate(
         cap.clone(),
         &options,
-        Some(fe.values().cloned().collect()),
+        Some(kappe::Given {
+            fe: fe.values().cloned().collect(),
+            refined: refined.clone(),
+        }),
         &kappe::no_progress,
     )
 }
@@ -380,7 +464,10 @@ fn report(outcome: &kappe::Outcome, runs: &[Vec<usize>]) -> Value {
             })
         })
         .collect();
-    let complete = done >= total;
+    // Every first-pass factor in and the mesh-error pass done (`refine`: the solves it asks
+    // for next, which the page hands to its workers).
+    let refine: Option<&RefineBatch> = a.refine_pending.as_ref();
+    let complete = done >= total && refine.is_none();
     json!({
         "complete": complete,
         "ok": if complete { Value::Bool(outcome.verdict.ok) } else { Value::Null },
@@ -388,6 +475,7 @@ fn report(outcome: &kappe::Outcome, runs: &[Vec<usize>]) -> Value {
         "min_blf": outcome.min_blf(),
         "states_done": done,
         "states_total": total,
+        "refine": refine,
         "states": states,
         "constraints": a.constraints,
         "failures": outcome.verdict.failures.iter().map(|f| f.to_string()).collect::<Vec<_>>(),
@@ -445,8 +533,10 @@ impl WorkerCore {
         }
     }
 
-    /// Analyse `run` (state indices of one [`fe_runs`] run, in order) of the design `text`;
-    /// `on_state` hears each state's result as JSON ([`FeWire`]) as it finishes.
+    /// Analyse `run` (state indices of one [`fe_runs`] run, in order) of the design `text` with
+    /// `blf_max_split = max_split` (1: the first pass, warm-started along the run; more: single
+    /// states of a [`RefineBatch`], each from a cold start as [`kappe::analysis::analyze`]
+    /// solves them); `on_state` hears each state's result as JSON ([`FeWire`]) as it finishes.
     ///
     /// # Errors
     /// The design's problem (the page checked it first) or a state that cannot be solved.
@@ -454,6 +544,7 @@ impl WorkerCore {
         &mut self,
         text: &str,
         run: &[usize],
+        max_split: usize,
         on_state: &mut dyn FnMut(String),
     ) -> Result<(), FieldError> {
         if self.cap.is_none() || self.text != text {
@@ -469,23 +560,29 @@ impl WorkerCore {
             return Ok(());
         };
         self.guess = None;
+        let max_split = max_split.max(1);
+        // The first pass: the print-layer mesh alone (the mesh error is estimated over all
+        // states together when every worker is done). A mesh-error solve: the options the pass
+        // asked for (`converge_fe` solves with `blf_max_split` 2, or the design's own).
+        let options = kappe::analysis::AnalysisOptions {
+            blf_max_split: max_split,
+            ..cap.design.analysis.clone()
+        };
         for &i in run {
-            // The first pass: the print-layer mesh alone (the mesh error is estimated over all
-            // states together when every worker is done).
             let request = kappe::analysis::FeRequest {
                 green: self.green.as_ref(),
                 extra: false,
             };
-            let fe = state_fe(
-                cap,
-                &cap.design.analysis.with_split_at_most(1),
-                i,
-                &mut self.guess,
-                &request,
-            )
-            .map_err(|e| FieldError::of(&e))?
-            .fe;
-            let wire = FeWire::from(&fe);
+            let mut cold = None;
+            let guess = if max_split == 1 {
+                &mut self.guess
+            } else {
+                &mut cold
+            };
+            let fe = state_fe(cap, &options, i, guess, &request)
+                .map_err(|e| FieldError::of(&e))?
+                .fe;
+            let wire = FeWire::of(&fe, max_split);
             on_state(serde_json::to_string(&[wire]).unwrap_or_default());
         }
         Ok(())
@@ -581,13 +678,16 @@ impl Worker {
         &mut self,
         text: &str,
         run: Vec<u32>,
+        max_split: u32,
         on_state: &js_sys_fn::Function,
     ) -> Result<(), JsValue> {
         let run: Vec<usize> = run.into_iter().map(|i| i as usize).collect();
         let mut call = |s: String| {
             let _ = on_state.call1(&JsValue::NULL, &JsValue::from_str(&s));
         };
-        self.0.run(text, &run, &mut call).map_err(js_err)
+        self.0
+            .run(text, &run, max_split as usize, &mut call)
+            .map_err(js_err)
     }
 }
 

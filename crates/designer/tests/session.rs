@@ -23,15 +23,43 @@ fn session_with_worker_results_equals_run() {
     let generation = loaded["generation"].as_u64().expect("generation");
     let mut worker = WorkerCore::new();
     let mut report = Value::Null;
-    for run in &runs {
-        let mut results = Vec::new();
+    let mut solve = |run: &[usize], max_split: usize, report: &mut Value| {
+        let mut results: Vec<String> = Vec::new();
         worker
-            .run(session.text(), run, &mut |s| results.push(s))
+            .run(
+                session.text().to_string().as_str(),
+                run,
+                max_split,
+                &mut |s| results.push(s),
+            )
             .expect("worker run");
         for r in results {
-            report = session.add_fe(generation, &r).expect("results taken");
+            *report = session.add_fe(generation, &r).expect("results taken");
         }
+    };
+    for run in &runs {
+        solve(run, 1, &mut report);
     }
+    // The page's part of the mesh-error pass: every batch the pass asks for, solved by a worker
+    // (in the page: one state per worker message, both workers), until it asks for none.
+    let mut batches = 0;
+    while let Some(batch) = report["refine"].as_object().cloned() {
+        assert_eq!(
+            report["complete"],
+            json!(false),
+            "a pass still asking is not complete"
+        );
+        let states: Vec<usize> = serde_json::from_value(batch["states"].clone()).expect("states");
+        let split = batch["max_split"].as_u64().expect("max_split") as usize;
+        assert!(!states.is_empty() && split >= 2, "{batch:?}");
+        solve(&states, split, &mut report);
+        batches += 1;
+        assert!(batches <= 64, "the pass keeps asking");
+    }
+    assert!(
+        batches >= 1,
+        "the converged BLF (the default) needs the 2×2 split somewhere"
+    );
     assert_eq!(report["complete"], json!(true));
 
     let design = kappe::Design::from_toml_str(SHORT).expect("design");

@@ -32,4 +32,4 @@ pub mod verdict;
 
 pub use form::{Cap, StateSummary, design_cap};
 pub use input::{Context, Design, DesignError};
-pub use run::{Options, Outcome, Progress, Stage, evaluate, no_progress, run};
+pub use run::{Given, Options, Outcome, Progress, Stage, evaluate, no_progress, run};

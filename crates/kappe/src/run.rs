@@ -201,10 +201,22 @@ pub fn run(
 pub fn evaluate(
     cap: Cap,
     options: &Options,
-    fe: Option<Vec<crate::analysis::check::StateFe>>,
+    given: Option<Given>,
     on_progress: OnProgress<'_>,
 ) -> Result<Outcome, DesignError> {
-    after_form(cap, options, on_progress, &AtomicBool::new(false), fe)
+    after_form(cap, options, on_progress, &AtomicBool::new(false), given)
+}
+
+/// The finite-element results [`evaluate`] is given, computed elsewhere (the designer's Web
+/// Workers): the first pass of the analysed states and the mesh-error pass's solves so far
+/// ([`crate::analysis::Request`]'s `fe` and `refined`).
+#[derive(Clone, Debug, Default)]
+pub struct Given {
+    /// [`crate::analysis::check::state_fe`] of the states over
+    /// [`crate::analysis::check::fe_runs`] (first pass, print-layer mesh).
+    pub fe: Vec<crate::analysis::check::StateFe>,
+    /// The mesh-error pass's solves ([`crate::analysis::check::RefineBatch`] asks for them).
+    pub refined: crate::analysis::check::RefineSolves,
 }
 
 fn after_form(
@@ -212,7 +224,7 @@ fn after_form(
     options: &Options,
     on_progress: OnProgress<'_>,
     stop: &AtomicBool,
-    given: Option<Vec<crate::analysis::check::StateFe>>,
+    given: Option<Given>,
 ) -> Result<Outcome, DesignError> {
     // The robot is planned first (planning does not depend on the analysis): with a plan, the
     // structural check takes every layer's age from the plan's clock (issue 11). Programs are
@@ -250,13 +262,18 @@ fn after_form(
     check(stop)?;
     let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
+    let (given_fe, refined) = match given {
+        Some(g) => (Some(g.fe), Some(g.refined)),
+        None => (None, None),
+    };
     let analysis = match &options.analysis {
         Some(o) => Some(crate::analysis::analyze(
             &cap,
             o,
             crate::analysis::Request {
                 schedule: Some(&schedule),
-                fe: given,
+                fe: given_fe,
+                refined,
                 context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
             },
         )?),

@@ -162,6 +162,28 @@ pub struct Analysis {
     pub timings: Timings,
     /// The as-printed shape (docs/as-printed.md; None when the buckling analysis is off).
     pub as_printed: Option<crate::analysis::asprinted::AsPrinted>,
+    /// The mesh-error pass's next batch, when its solves are made elsewhere
+    /// ([`Request::refined`]) and this one is not among them yet: the factors are then the
+    /// first pass's and the verdict is partial. Always `None` when the analysis solves itself.
+    pub refine_pending: Option<RefineBatch>,
+}
+
+/// The mesh-error pass's single-state solves made elsewhere (the designer's Web Workers, issue
+/// 25), by state and the `blf_max_split` they were solved with ([`state_fe`] from a cold start,
+/// as [`solve_states`] does): [`converge_fe`] asks for batches of both kinds.
+pub type RefineSolves = std::collections::BTreeMap<(usize, usize), StateFe>;
+
+/// A batch of the mesh-error pass that [`Request::refined`] does not hold yet: solve `states`
+/// with `blf_max_split = max_split` and analyse again with the results added. The pass is
+/// deterministic given the first-pass factors and these solves, so replaying it costs only its
+/// bookkeeping, and the batches come out as [`analyze`] would solve them itself.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct RefineBatch {
+    /// The states to solve, in print order.
+    pub states: Vec<usize>,
+    /// The `blf_max_split` to solve them with (2: the 2×2 split; more: the states that could
+    /// govern, refined until converged).
+    pub max_split: usize,
 }
 
 impl Analysis {
@@ -598,6 +620,10 @@ pub struct Request<'a> {
     /// [`analyze`] solves itself. A selected state missing here counts as not analysed (the
     /// designer's partial verdict while its workers run). `None`: solve every selected state.
     pub fe: Option<Vec<StateFe>>,
+    /// With [`Self::fe`]: the mesh-error pass's solves made elsewhere so far. The pass then
+    /// solves nothing itself: it stops at the first batch this lacks and names it in
+    /// [`Analysis::refine_pending`]. `None`: the pass solves its states here, in turn.
+    pub refined: Option<RefineSolves>,
     /// Progress (one step per buckling analysis finished) and cancellation (checked before every
     /// state's rebuild and buckling solve).
     pub context: Context<'a>,
@@ -614,7 +640,14 @@ pub fn analyze(
     request: Request<'_>,
 ) -> Result<Analysis, DesignError> {
     match request.fe {
-        Some(fe) => analyze_from_fe(cap, options, request.schedule, fe, request.context),
+        Some(fe) => analyze_from_fe(
+            cap,
+            options,
+            request.schedule,
+            fe,
+            request.refined.as_ref(),
+            request.context,
+        ),
         None => analyze_all(cap, options, request.schedule, request.context),
     }
 }
@@ -625,6 +658,7 @@ fn analyze_from_fe(
     options: &AnalysisOptions,
     schedule: Option<&crate::schedule::Schedule>,
     fe: Vec<StateFe>,
+    refined: Option<&RefineSolves>,
     context: Context<'_>,
 ) -> Result<Analysis, DesignError> {
     options.validate()?;
@@ -638,15 +672,51 @@ fn analyze_from_fe(
         .iter()
         .map(Vec::len)
         .sum();
-    let complete = fe.len() >= selected;
-    let interpolated = if complete {
-        converge_fe(options, &mut fe, &mut |states, opts| {
+    let mut complete = fe.len() >= selected;
+    let mut pending = None;
+    let interpolated = match (complete, refined) {
+        (false, _) => Vec::new(),
+        (true, None) => converge_fe(options, &mut fe, &mut |states, opts| {
             solve_states(cap, opts, green.as_ref(), states)
-        })?
-    } else {
-        Vec::new()
+        })?,
+        (true, Some(refined)) => {
+            // On a clone, so a pass stopped at a missing batch leaves the first-pass factors.
+            let mut tried = fe.clone();
+            let outcome = converge_fe(options, &mut tried, &mut |states, opts| {
+                let split = opts.blf_max_split;
+                let missing: Vec<usize> = states
+                    .iter()
+                    .copied()
+                    .filter(|&s| !refined.contains_key(&(s, split)))
+                    .collect();
+                if missing.is_empty() {
+                    Ok(states
+                        .iter()
+                        .filter_map(|&s| refined.get(&(s, split)).cloned())
+                        .collect())
+                } else {
+                    pending = Some(RefineBatch {
+                        states: missing,
+                        max_split: split,
+                    });
+                    // Stops the pass: not an error once `pending` names what it lacks.
+                    Err(DesignError::Cancelled)
+                }
+            });
+            match outcome {
+                Ok(interpolated) => {
+                    fe = tried;
+                    interpolated
+                }
+                Err(DesignError::Cancelled) if pending.is_some() => {
+                    complete = false;
+                    Vec::new()
+                }
+                Err(e) => return Err(e),
+            }
+        }
     };
-    assemble(
+    let mut analysis = assemble(
         cap,
         options,
         green,
@@ -657,7 +727,9 @@ fn analyze_from_fe(
         Default::default(),
         Default::default(),
         context.stop_flag(),
-    )
+    )?;
+    analysis.refine_pending = pending;
+    Ok(analysis)
 }
 
 /// [`analyze`] solving every selected state itself.
@@ -1226,5 +1298,6 @@ fn assemble(
             as_printed: wall_printed,
         },
         as_printed,
+        refine_pending: None,
     })
 }

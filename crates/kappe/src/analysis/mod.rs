@@ -58,7 +58,10 @@ pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, s
 pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf, time_state_blf_ages};
 pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
-pub use check::{FeRequest, StateFe, StateFeSolve, analysis_green, fe_runs, levers, state_fe};
+pub use check::{
+    FeRequest, RefineBatch, RefineSolves, StateFe, StateFeSolve, analysis_green, fe_runs, levers,
+    state_fe,
+};
 pub use collapse::{
     CURVE_POINTS, CollapseMode, StateLba, cap_as_printed_shift, cap_state_collapse, cap_state_lba,
     object_as_printed_shift, shifted,
