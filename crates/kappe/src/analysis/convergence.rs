@@ -348,8 +348,9 @@ mod tests {
         // Where the relaxed test interpolates (far), the brackets cover the states' own pairs.
         // Where only the strict test may (near), an interval whose probes agree to within
         // `tolerance/10` is interpolated with its bracket widened by that agreement alone, and
-        // a state between the probes can miss it by about as much again: 2·Richardson·(tolerance/10)
-        // = 0.2 % of the factor at most (as before the relaxed test; docs/convergence.md).
+        // a state between the probes can miss it by about as much again (a smooth wobble like
+        // this one: 2·Richardson·(tolerance/10) = 0.2 % of the factor; a jump between the probes
+        // can miss it by more, as before the relaxed test; docs/convergence.md).
         let (far, near) = (run(&falling, 0.0), run(&flat, 0.002));
         assert!(
             far < near,
