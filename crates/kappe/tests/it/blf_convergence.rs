@@ -72,8 +72,13 @@ fn the_converged_factor_of_an_early_state_is_within_the_tolerance() {
 }
 
 /// A short cap analysed as `kappe design` does (the split on an adaptive sample of states) and
-/// with the split solved in every state: every state's factor agrees within the tolerance, the
-/// governing state is the same and is solved, not interpolated, and converged.
+/// with the split solved in every state: every state's every-state factor lies in the sampled
+/// bracket [blf, blf·(1 + blf_error)], the governing state is the same and is solved, not
+/// interpolated, and converged. The sampled value may lie above the every-state one by the
+/// tolerance at most: an interval the strict test accepts (probes within tolerance/10 of the
+/// quadratic) is widened by that disagreement alone, and a start-section state between the
+/// probes can jump further (this cap's state 18: 0.44 % above, the same on main before the
+/// relaxed test; the default, corrugated and 1.2 m caps: 0.033 % at most, docs/convergence.md).
 #[test]
 fn sampled_states_match_every_state_solved() {
     let d = kappe::Design::from_toml_str("[cap]\nlength = 0.3\n").unwrap();
@@ -109,7 +114,13 @@ fn sampled_states_match_every_state_solved() {
     let mut interpolated = 0;
     for (a, b) in sampled.states.iter().zip(&all.states) {
         if let (Some(x), Some(y)) = (a.blf, b.blf) {
-            assert!((x / y - 1.0).abs() <= tol, "state {}: {x} vs {y}", a.index);
+            let err = a.blf_error.unwrap();
+            assert!(x <= y * (1.0 + tol), "state {}: {x} vs {y}", a.index);
+            assert!(
+                y <= x * (1.0 + err) * (1.0 + 1e-9),
+                "state {}: {x} vs {y}",
+                a.index
+            );
             interpolated += usize::from(a.blf_interpolated == Some(true));
         }
     }
