@@ -457,7 +457,7 @@ fn crossing_zero(
     }
     let lin = l0 + (l1 - l0) * m0 / (m0 - m1);
     let (la, ma) = before?;
-    if !(la < l0) {
+    if la >= l0 || la.is_nan() {
         return None;
     }
     // Newton form through (la, ma), (l0, m0), (l1, m1); its root in [l0, l1].
