@@ -84,7 +84,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cl = cl.min(cpu() - c);
         }
         let (t, c0) = (Instant::now(), cpu());
-        let c = cap_state_collapse(&cap, &options, &spec, None, q)?;
+        let c = cap_state_collapse(&cap, &options, &spec, None, q, f64::INFINITY)?;
         let (tp, cp) = (t.elapsed().as_secs_f64(), cpu() - c0);
         if let Some(c) = c {
             println!(
@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 ..spec
             };
             let (t, c0) = (Instant::now(), cpu());
-            if let Some(c) = cap_state_collapse(&cap, &options, &ap, None, q)? {
+            if let Some(c) = cap_state_collapse(&cap, &options, &ap, None, q, f64::INFINITY)? {
                 println!(
                     "  {q:>5} as-printed start: collapse {:.4} {} ({} steps, {} LDLt; {:.2} s wall, {:.2} s CPU)",
                     c.factor,

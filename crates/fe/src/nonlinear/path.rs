@@ -70,6 +70,25 @@ pub struct PathOptions {
     /// passes a load maximum without the tangent's sign test; it also saves the predictor's
     /// solve.
     pub secant_predictor: bool,
+    /// Locate a critical point that a rising step crosses (the tangent's inertia changes)
+    /// from the tangent's eigenvalue nearest zero, μ, instead of cutting the step until the
+    /// crossing is bracketed within 10⁻³ in λ (default false). μ is computed at every
+    /// converged step (inverse iteration with the step's factor, warm-started from the last
+    /// step's vector); a crossing step is accepted when the zero of μ(λ) interpolated
+    /// linearly between the two steps around it and the zero of the parabola through the
+    /// last three steps agree within 10⁻³ in λ, and the lower of the two is the critical λ
+    /// (docs/nonlinear.md, "Locating a critical point"). Otherwise the step is cut as
+    /// without it. Load maxima (λ falls) are bracketed as before.
+    pub locate_by_eigenvalue: bool,
+    /// Keep the factor of a step's last full-Newton iteration as the converged point's
+    /// (its inertia, μ and the next step's modified-Newton factor) instead of factorizing the
+    /// tangent at the converged point again, when the step's last correction was a full-Newton
+    /// one (default false). That tangent is one converging correction away from the
+    /// converged point (the residual then was already small), so its inertia and μ differ
+    /// from the converged tangent's only within a step of the critical point that
+    /// `locate_by_eigenvalue` resolves anyway; it saves one LDLᵀ per step (a third of a
+    /// cap state's).
+    pub reuse_iteration_factor: bool,
     /// Length ℓ weighting rotations in the arc-length norm (rotation·ℓ ≈ a translation);
     /// `None` (default): the mean edge length of the mesh.
     pub rotation_length: Option<f64>,
@@ -96,6 +115,8 @@ impl Default for PathOptions {
             stop_at_limit: true,
             modified_newton: false,
             secant_predictor: false,
+            locate_by_eigenvalue: false,
+            reuse_iteration_factor: false,
             rotation_length: None,
             local_geometric: true,
         }
@@ -388,12 +409,27 @@ fn solve(f: &Ldlt<'_>, rhs: &[f64]) -> Result<Vec<f64>, FeError> {
 /// Eigenvalue of the tangent closest to zero, by a few steps of inverse iteration with its
 /// factor (Rayleigh quotient of the last iterate).
 fn eig_near_zero(f: &Ldlt<'_>, kv: &Tangent, p: &Problem<'_>) -> Result<f64, FeError> {
+    Ok(eig_near_zero_from(f, kv, p, None, 8)?.0)
+}
+
+/// As [`eig_near_zero`], warm-started from `start` (the previous step's vector; `None`: the
+/// fixed start, 8 iterations) with `iterations` steps; returns μ and the vector.
+fn eig_near_zero_from(
+    f: &Ldlt<'_>,
+    kv: &Tangent,
+    p: &Problem<'_>,
+    start: Option<&[f64]>,
+    iterations: usize,
+) -> Result<(f64, Vec<f64>), FeError> {
     let n = p.q.len();
-    let mut x: Vec<f64> = (0..n)
-        .map(|i| 1.0 + ((i * 7919) % 101) as f64 / 101.0)
-        .collect();
+    let mut x: Vec<f64> = match start {
+        Some(v) if v.len() == n => v.to_vec(),
+        _ => (0..n)
+            .map(|i| 1.0 + ((i * 7919) % 101) as f64 / 101.0)
+            .collect(),
+    };
     let mut y = vec![0.0; n];
-    for _ in 0..8 {
+    for _ in 0..iterations {
         let nx = norm(&x);
         x.iter_mut().for_each(|v| *v /= nx);
         x = solve(f, &x)?;
@@ -401,7 +437,49 @@ fn eig_near_zero(f: &Ldlt<'_>, kv: &Tangent, p: &Problem<'_>) -> Result<f64, FeE
     let nx = norm(&x);
     x.iter_mut().for_each(|v| *v /= nx);
     p.pattern.sym_matvec(&kv.sym, &x, &mut y);
-    Ok(x.iter().zip(&y).map(|(a, b)| a * b).sum())
+    Ok((x.iter().zip(&y).map(|(a, b)| a * b).sum(), x))
+}
+
+/// The zero of μ(λ) in a step (λ0, μ0 > 0) → (λ1, μ1 < 0) that crossed it, when the linear
+/// interpolation and the parabola through `before` (the step ahead of λ0) and the two agree
+/// within `tol` in λ: the lower of the two (for a μ concave in λ, as it is approaching a
+/// critical point, the chord's zero is the lower one).
+fn crossing_zero(
+    before: Option<(f64, f64)>,
+    l0: f64,
+    m0: f64,
+    l1: f64,
+    m1: f64,
+    tol: f64,
+) -> Option<f64> {
+    if !(m0 > 0.0 && m1 < 0.0 && l1 > l0) {
+        return None;
+    }
+    let lin = l0 + (l1 - l0) * m0 / (m0 - m1);
+    let (la, ma) = before?;
+    if la >= l0 || la.is_nan() {
+        return None;
+    }
+    // Newton form through (la, ma), (l0, m0), (l1, m1); its root in [l0, l1].
+    let d0 = (m0 - ma) / (l0 - la);
+    let d1 = (m1 - m0) / (l1 - l0);
+    let c = (d1 - d0) / (l1 - la);
+    let (a, b, cc) = (c, d1 - c * (l0 + l1), m1 - d1 * l1 + c * l0 * l1);
+    let quad = if a.abs() <= 1e-12 * b.abs() {
+        -cc / b
+    } else {
+        let disc = b * b - 4.0 * a * cc;
+        if disc < 0.0 {
+            return None;
+        }
+        let sq = disc.sqrt();
+        let q = -0.5 * (b + b.signum() * sq);
+        [q / a, cc / q]
+            .into_iter()
+            .filter(|r| r.is_finite() && *r >= l0 && *r <= l1)
+            .fold(f64::NAN, f64::min)
+    };
+    (quad.is_finite() && (quad - lin).abs() <= tol).then_some(lin.min(quad))
 }
 
 struct Converged<'a> {
@@ -533,6 +611,8 @@ impl<'a, 'm> Solver<'a, 'm> {
         // Newton once it stalls (residual not halved) or after MODIFIED_MAX iterations.
         let mut full = !self.opt.modified_newton || p.has_moments;
         let mut own: Option<(Ldlt<'a>, Tangent)> = None;
+        // The last correction used a factor computed in its own iteration.
+        let mut own_fresh = false;
         let mut prev_rel = f64::INFINITY;
         let (mut n_full, mut n_mod) = (0usize, 0usize);
         for it in 0..=self.opt.max_iterations {
@@ -547,12 +627,25 @@ impl<'a, 'm> Solver<'a, 'm> {
                 return Ok(None);
             }
             if rel <= self.opt.tolerance {
-                let kv = match kv_now {
-                    Some(k) => k,
-                    None => self.evaluate(&st)?.1,
+                let reuse = if self.opt.reuse_iteration_factor && own_fresh {
+                    own.take()
+                } else {
+                    None
                 };
-                let Some(factor) = self.factor(&kv)? else {
-                    return Ok(None);
+                let (factor, kv) = match reuse {
+                    // The converged tangent (assembled for this check) with the last
+                    // iteration's factor.
+                    Some((f, k)) => (f, kv_now.unwrap_or(k)),
+                    None => {
+                        let kv = match kv_now {
+                            Some(k) => k,
+                            None => self.evaluate(&st)?.1,
+                        };
+                        let Some(factor) = self.factor(&kv)? else {
+                            return Ok(None);
+                        };
+                        (factor, kv)
+                    }
                 };
                 return Ok(Some(Converged {
                     state: st,
@@ -578,8 +671,10 @@ impl<'a, 'm> Solver<'a, 'm> {
                     return Ok(None);
                 };
                 own = Some((f, kv));
+                own_fresh = true;
                 n_full += 1;
             } else {
+                own_fresh = false;
                 n_mod += 1;
             }
             let (factor, kv): (&Ldlt<'_>, &Tangent) = match own.as_ref() {
@@ -739,6 +834,15 @@ pub fn nonlinear_path(
     let mut limit: Option<LimitPoint> = None;
     let mut s_cum = vec![0.0];
     let mut rising = true;
+    // (λ, μ) of the converged steps (from λ = 0) and the last eigenvector, with
+    // `locate_by_eigenvalue`.
+    let mut mu_hist: Vec<(f64, f64)> = Vec::new();
+    let mut mu_vec: Option<Vec<f64>> = None;
+    if options.locate_by_eigenvalue {
+        let (m, v) = eig_near_zero_from(&factor, &kvals, &problem, None, 8)?;
+        mu_hist.push((0.0, m));
+        mu_vec = Some(v);
+    }
     let stop;
     loop {
         if steps.len() >= options.max_steps {
@@ -747,6 +851,8 @@ pub fn nonlinear_path(
         }
         // Attempt a step, cutting on failure.
         let mut to_max = false;
+        // μ at the accepted step and the critical λ located from it.
+        let mut located: Option<(f64, Vec<f64>, Option<f64>)> = None;
         let conv = loop {
             let ctrl = if arc && !to_max {
                 StepControl::Arc {
@@ -764,6 +870,33 @@ pub fn nonlinear_path(
                 Some(c) if arc && !to_max && c.lambda > options.lambda_max => {
                     // Overshot λ_max: redo the step load-controlled to λ_max exactly.
                     to_max = true;
+                }
+                Some(c)
+                    if options.locate_by_eigenvalue
+                        && arc
+                        && c.factor.negative == neg + 1
+                        && c.lambda > lambda
+                        && mu_hist.len() >= 2 =>
+                {
+                    let (m1, v1) =
+                        eig_near_zero_from(&c.factor, &c.kvals, &problem, mu_vec.as_deref(), 4)?;
+                    let (l0, m0) = mu_hist[mu_hist.len() - 1];
+                    let before = mu_hist.get(mu_hist.len() - 2).copied();
+                    let tol = LOCATE * lambda.abs().max(options.initial_increment);
+                    match crossing_zero(before, l0, m0, c.lambda, m1, tol) {
+                        Some(z) => {
+                            located = Some((m1, v1, Some(z)));
+                            break Some(c);
+                        }
+                        None if (c.lambda - lambda).abs() > tol && 0.5 * size >= smin => {
+                            solver.stats.cut_steps += 1;
+                            size *= 0.5;
+                        }
+                        None => {
+                            located = Some((m1, v1, None));
+                            break Some(c);
+                        }
+                    }
                 }
                 Some(c)
                     if arc
@@ -818,9 +951,16 @@ pub fn nonlinear_path(
             } else if new_neg > neg && c.lambda >= lambda {
                 passed = true;
                 // The eigenvalue that crossed zero: interpolate between its estimates.
-                let e1 = eig_near_zero(&c.factor, &c.kvals, &problem)?;
-                let e0 = eig_near_zero(&factor, &kvals, &problem)?;
-                let lam = if e0 > 0.0 && e1 < 0.0 {
+                let (e0, e1) = match (&located, mu_hist.last()) {
+                    (Some((m1, _, _)), Some(&(_, m0))) => (m0, *m1),
+                    _ => (
+                        eig_near_zero(&factor, &kvals, &problem)?,
+                        eig_near_zero(&c.factor, &c.kvals, &problem)?,
+                    ),
+                };
+                let lam = if let Some((_, _, Some(z))) = &located {
+                    *z
+                } else if e0 > 0.0 && e1 < 0.0 {
                     lambda + (c.lambda - lambda) * e0 / (e0 - e1)
                 } else {
                     c.lambda
@@ -849,6 +989,14 @@ pub fn nonlinear_path(
         };
         let flow = on_step(&ps);
         steps.push(ps);
+        if options.locate_by_eigenvalue {
+            let (m, v) = match located {
+                Some((m, v, _)) => (m, v),
+                None => eig_near_zero_from(&c.factor, &c.kvals, &problem, mu_vec.as_deref(), 4)?,
+            };
+            mu_hist.push((c.lambda, m));
+            mu_vec = Some(v);
+        }
         // Next step size.
         let ratio = (options.target_iterations as f64 / c.cost.max(1.0)).sqrt();
         size = (size * ratio.clamp(0.5, 2.0)).clamp(smin, smax);

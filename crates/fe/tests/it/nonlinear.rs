@@ -718,17 +718,23 @@ fn panel_bifurcation_matches_linear_buckling() {
     assert!(gaps[1] < 0.01, "{gaps:?}");
 }
 
-/// The collapse check's fast options (modified Newton, secant predictor; docs/nonlinear.md
-/// "Speed") trace the same path as full Newton with the tangent predictor: the limit point
-/// of the imperfect Roorda frame within 2e-3 relative. That is twice the path's own
-/// location tolerance (a step crossing a change of the tangent's inertia is shortened to
-/// 1e-3 of λ, `LOCATE`): the two runs bracket the same point from different steps. What they
-/// save is measured by the benchmarks (docs/nonlinear.md "Speed"), not asserted here.
+/// The collapse check's fast options (modified Newton, secant predictor, the critical point
+/// located from the tangent's eigenvalue nearest zero, the last iteration's factor kept;
+/// docs/nonlinear.md "Speed") find the same critical points as full Newton with the tangent
+/// predictor and bracketing: the load maximum of the imperfect Roorda frame and the
+/// bifurcation of the perfect axially compressed panel, within 2e-3 relative. That is twice
+/// the path's own location tolerance (a step crossing a change of the tangent's inertia is
+/// shortened to 1e-3 of λ, `LOCATE`; the eigenvalue location accepts a crossing step only when
+/// its two interpolations agree within the same 1e-3): the runs reach the point from different
+/// steps. What they save is measured by the benchmarks (docs/nonlinear.md "Speed"), not
+/// asserted here.
 #[test]
 fn fast_path_options_find_the_same_limit_points() {
     let fast = |o: PathOptions| PathOptions {
         modified_newton: true,
         secant_predictor: true,
+        locate_by_eigenvalue: true,
+        reuse_iteration_factor: true,
         ..o
     };
     let (m, _) = roorda_frame(20);
@@ -743,16 +749,37 @@ fn fast_path_options_find_the_same_limit_points() {
     let lam_lba = lba.factors[0];
     // The sign whose path has a limit point (the other rises on the stable branch of the
     // asymmetric bifurcation to λ_max).
-    let cases: Vec<(String, ShellModel, PathOptions)> = vec![(
-        "Roorda frame, w0 = 0.001".into(),
-        with_imperfection(&m, &lba.modes[0], 1e-3).unwrap(),
-        PathOptions {
-            initial_increment: 0.2 * lam_lba,
-            lambda_max: 1.5 * lam_lba,
-            max_steps: 80,
+    let panel = axial_panel(24, 18);
+    let lam_panel = buckling(
+        &panel,
+        &BucklingOptions {
+            modes: 1,
             ..Default::default()
         },
-    )];
+    )
+    .unwrap()
+    .factors[0];
+    let cases: Vec<(String, ShellModel, PathOptions)> = vec![
+        (
+            "Roorda frame, w0 = 0.001".into(),
+            with_imperfection(&m, &lba.modes[0], 1e-3).unwrap(),
+            PathOptions {
+                initial_increment: 0.2 * lam_lba,
+                lambda_max: 1.5 * lam_lba,
+                max_steps: 80,
+                ..Default::default()
+            },
+        ),
+        (
+            "perfect panel 24×18 (bifurcation)".into(),
+            panel,
+            PathOptions {
+                initial_increment: 0.5 * lam_panel,
+                lambda_max: 1.5 * lam_panel,
+                ..Default::default()
+            },
+        ),
+    ];
     for (name, model, opt) in cases {
         let slow = run(&model, &opt);
         let quick = run(&model, &fast(opt.clone()));
@@ -761,8 +788,12 @@ fn fast_path_options_find_the_same_limit_points() {
             quick.limit.expect("fast options: no limit point").lambda,
         );
         println!(
-            "{name}: limit {a:.6} ({} LDLᵀ) vs fast {b:.6} ({} LDLᵀ, {} force evaluations)",
-            slow.stats.factorizations, quick.stats.factorizations, quick.stats.force_evaluations
+            "{name}: limit {a:.6} ({} LDLᵀ, {} assemblies) vs fast {b:.6} ({} LDLᵀ, {} assemblies, {} force evaluations)",
+            slow.stats.factorizations,
+            slow.stats.assemblies,
+            quick.stats.factorizations,
+            quick.stats.assemblies,
+            quick.stats.force_evaluations
         );
         assert!((b / a - 1.0).abs() < 2e-3, "{name}: {a} vs {b}");
         for s in &quick.steps {

@@ -1123,7 +1123,7 @@ fn assemble(
                 })
             })
             .collect();
-        let found = crate::analysis::collapse::cap_states_to_run(&bounds, false, &|top| {
+        let found = crate::analysis::collapse::cap_states_to_run(&bounds, false, &|top, above| {
             cancelled()?;
             crate::analysis::collapse::cap_state_collapse(
                 cap,
@@ -1131,6 +1131,7 @@ fn assemble(
                 &nonlinear,
                 green.as_ref(),
                 top,
+                above,
             )
         })?;
         for (q, c) in found {

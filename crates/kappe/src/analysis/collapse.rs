@@ -82,6 +82,12 @@ pub struct CollapseOptions {
     /// (the 60-layer Wolfs cylinder: 28.0 → 32.6 s CPU with them), so the objects run full
     /// Newton.
     pub fast_path: bool,
+    /// Stop a path at its first converged step at or above this load factor when it has met
+    /// no limit point and no material failure there (`f64::INFINITY`: off). The state rule
+    /// passes the least collapse factor found so far (docs/collapse.md §3): a state that gets
+    /// past it cannot govern, and its collapse factor is reported as a lower bound
+    /// (`not_reached`, the λ of that step).
+    pub stop_above: f64,
 }
 
 /// The collapse of one state.
@@ -185,7 +191,8 @@ pub fn collapse_factor(
             time,
             options,
             sign,
-            best.as_ref().map_or(f64::INFINITY, |b| b.factor),
+            best.as_ref()
+                .map_or(options.stop_above, |b| b.factor.min(options.stop_above)),
         )?;
         assemblies += c.assemblies;
         factorizations += c.factorizations;
@@ -254,12 +261,24 @@ fn one_path(
     let lam_mat = linear_strength
         .filter(|u| u.is_finite() && *u > 0.0)
         .map_or(f64::INFINITY, |u| 1.0 / u);
+    let bound = lba.min(lam_mat);
+    // A path that only has to pass `above` (the other sign's collapse factor, or the least
+    // one of the state rule, docs/collapse.md §3) aims its first step 10 % past it, if that is
+    // below 0.8 of the linear bound: far from its limit a path is nearly linear and lands
+    // within a few per cent of the aimed λ, so one step often decides it. A step that crosses
+    // a limit point on the way is cut as any other.
+    let mut first = 0.5 * bound;
+    if options.fast_path && above.is_finite() {
+        first = first.max((1.1 * above).min(0.8 * bound));
+    }
     let opt = PathOptions {
-        initial_increment: 0.5 * lba.min(lam_mat),
+        initial_increment: first,
         lambda_max: 1.5 * lba,
         // docs/collapse.md §6: the same path at a fraction of the factorizations.
         modified_newton: options.fast_path,
         secant_predictor: options.fast_path,
+        locate_by_eigenvalue: options.fast_path,
+        reuse_iteration_factor: options.fast_path,
         ..Default::default()
     };
     let check_material = (options.strength || options.sliding) && time.strength.is_some();
@@ -409,7 +428,7 @@ pub const KNOCKDOWN_FLOOR: f64 = 0.5;
 pub fn cap_states_to_run(
     bounds: &[LinearBound],
     all: bool,
-    run: &(dyn Fn(usize) -> Result<Option<Collapse>, DesignError> + Sync),
+    run: &(dyn Fn(usize, f64) -> Result<Option<Collapse>, DesignError> + Sync),
 ) -> Result<Vec<(usize, Collapse)>, DesignError> {
     use rayon::prelude::*;
     let mut order: Vec<LinearBound> = bounds
@@ -431,12 +450,14 @@ pub fn cap_states_to_run(
         let hi = (next + batch).min(order.len());
         let part: Vec<(LinearBound, Option<Collapse>)> = order[next..hi]
             .par_iter()
-            .map(|b| run(b.state).map(|c| (*b, c)))
+            .map(|b| run(b.state, if all { f64::INFINITY } else { least }).map(|c| (*b, c)))
             .collect::<Result<_, DesignError>>()?;
         for (b, c) in part {
             if let Some(c) = c {
                 least = least.min(c.factor);
-                if b.bound > 0.0 {
+                // A path stopped at `least` (or at λ_max) measured no knockdown, only a
+                // lower bound on it: it must not lower the floor.
+                if b.bound > 0.0 && c.mode != CollapseMode::NotReached {
                     knockdown = knockdown.min(c.factor / b.bound);
                 }
                 done.push((b.state, c));
@@ -523,6 +544,7 @@ pub fn cap_state_collapse(
     spec: &crate::input::nonlinear::NonlinearSpec,
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
+    above: f64,
 ) -> Result<Option<Collapse>, DesignError> {
     let Some(StateLba { state, shell, lba }) = cap_state_lba(cap, options, green, top)? else {
         return Ok(None);
@@ -599,6 +621,7 @@ pub fn cap_state_collapse(
             strength: spec.material,
             sliding: spec.material,
             fast_path: true,
+            stop_above: above,
         },
     )
     .map(Some)

@@ -63,8 +63,8 @@ pub use check::{
     state_fe,
 };
 pub use collapse::{
-    CURVE_POINTS, CollapseMode, StateLba, cap_as_printed_shift, cap_state_collapse, cap_state_lba,
-    object_as_printed_shift, shifted,
+    CURVE_POINTS, CollapseMode, CollapseOptions, StateLba, cap_as_printed_shift,
+    cap_state_collapse, cap_state_lba, collapse_factor, object_as_printed_shift, shifted,
 };
 pub use graded::{Grading, graded_rows, graded_state};
 pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli};

@@ -587,6 +587,7 @@ pub fn check_layers_warm(
                 strength: c.strength && nl.material,
                 sliding: c.sliding && nl.material,
                 fast_path: false,
+                stop_above: f64::INFINITY,
             };
             let shape = mode.clone().unwrap_or_default();
             // docs/collapse.md §8: the path from the as-printed geometry.

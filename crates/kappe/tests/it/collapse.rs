@@ -295,3 +295,157 @@ fn a_straight_wall_runs_one_sign() {
     assert_eq!(two.factor, one.factor);
     assert_eq!(two.factorizations, one.factorizations);
 }
+
+/// The cap states' fast path (docs/collapse.md §6: modified Newton, the secant predictor, the
+/// critical point located from the tangent's eigenvalue nearest zero, the last iteration's
+/// factor kept) against the full path (full Newton, tangent predictor, cut steps bracketing
+/// the critical point to 10⁻³ in λ) on the 12-layer Wolfs cylinder (24 segments), limit point
+/// only, w0 = 2, 0.02 and 0 mm. The same critical point within 2e-3 relative: twice the
+/// path's own location tolerance of 10⁻³ (the two runs reach it from different steps). And
+/// λ_collapse → λ_LBA as w0 → 0 still holds with the fast path: w0 = 0.02 mm within 1 % of
+/// the perfect path (as `collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes`), whose
+/// critical point lies above λ_LBA by less than 20 % (the pre-buckling effect of this state,
+/// docs/collapse.md §4).
+#[test]
+fn the_fast_path_finds_the_full_paths_collapse_factor() {
+    use kappe::analysis::{CollapseOptions, GreenOptions, check_state, collapse_factor};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, buckling};
+    let n = 12;
+    let r = cylinder("material = false");
+    let (mut model, layers) = object_shell(&r, n);
+    let ages = r.schedule.ages(n);
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+        None,
+    )
+    .unwrap();
+    let b = buckling(
+        &model,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let (lba, mode) = (b.factors[0], &b.modes[0]);
+    let run = |w0: f64, fast_path: bool| {
+        collapse_factor(
+            &model,
+            mode,
+            lba,
+            None,
+            &layers,
+            &ages,
+            &r.time,
+            &CollapseOptions {
+                w0,
+                signs: 1,
+                strength: false,
+                sliding: false,
+                fast_path,
+                stop_above: f64::INFINITY,
+            },
+        )
+        .unwrap()
+    };
+    let mut fast = Vec::new();
+    for w0 in [2e-3, 2e-5, 0.0] {
+        let (full, quick) = (run(w0, false), run(w0, true));
+        println!(
+            "w0 = {w0}: full {:.6} {} ({} LDLᵀ), fast {:.6} {} ({} LDLᵀ)",
+            full.factor,
+            full.mode.name(),
+            full.factorizations,
+            quick.factor,
+            quick.mode.name(),
+            quick.factorizations
+        );
+        assert_eq!(full.mode, CollapseMode::LimitPoint, "w0 = {w0}: {full:?}");
+        assert_eq!(quick.mode, CollapseMode::LimitPoint, "w0 = {w0}: {quick:?}");
+        assert!(
+            (quick.factor / full.factor - 1.0).abs() < 2e-3,
+            "w0 = {w0}: fast {} vs full {}",
+            quick.factor,
+            full.factor
+        );
+        fast.push(quick.factor);
+    }
+    assert!((fast[1] / fast[2] - 1.0).abs() < 0.01, "{fast:?}");
+    assert!(
+        fast[2] > lba && fast[2] < 1.2 * lba,
+        "{fast:?} vs LBA {lba}"
+    );
+}
+
+/// The state rule's early stop (docs/collapse.md §3): a path asked to stop above a factor it
+/// cannot reach first (here half the state's own collapse factor) stops at its first step at
+/// or above it, reports `not_reached` with that step's λ, which lies between the requested
+/// factor and the state's own collapse factor (a lower bound on it), and costs fewer
+/// factorizations than the full path.
+#[test]
+fn a_path_stops_above_the_least_collapse_factor_with_a_lower_bound() {
+    use kappe::analysis::{CollapseOptions, GreenOptions, check_state, collapse_factor};
+    use kappe::commands::buildability::object_shell;
+    use kappe_fe::{BucklingOptions, buckling};
+    let n = 12;
+    let r = cylinder("material = false");
+    let (mut model, layers) = object_shell(&r, n);
+    let ages = r.schedule.ages(n);
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+        None,
+    )
+    .unwrap();
+    let b = buckling(
+        &model,
+        &BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let run = |stop_above: f64| {
+        collapse_factor(
+            &model,
+            &b.modes[0],
+            b.factors[0],
+            None,
+            &layers,
+            &ages,
+            &r.time,
+            &CollapseOptions {
+                w0: 2e-3,
+                signs: 1,
+                strength: false,
+                sliding: false,
+                fast_path: true,
+                stop_above,
+            },
+        )
+        .unwrap()
+    };
+    let own = run(f64::INFINITY);
+    let star = 0.5 * own.factor;
+    let cut = run(star);
+    println!(
+        "own {:.6} ({} LDLᵀ); stopped above {star:.6}: {:.6} {} ({} LDLᵀ)",
+        own.factor,
+        own.factorizations,
+        cut.factor,
+        cut.mode.name(),
+        cut.factorizations
+    );
+    assert_eq!(own.mode, CollapseMode::LimitPoint);
+    assert_eq!(cut.mode, CollapseMode::NotReached);
+    assert!(cut.factor >= star && cut.factor < own.factor, "{cut:?}");
+    assert!(cut.factorizations < own.factorizations);
+}
