@@ -331,6 +331,9 @@ pub struct TimeBuckling<'a> {
     /// and then for g and its gradient at the same point once it is accepted; one re-solve
     /// (eigensolve and sensitivity solves) serves both, and the numbers are the same.
     pub last: Option<(Vec<f64>, f64, Vec<f64>)>,
+    /// The state's shell and solver, built on first use and kept for every iterate (see
+    /// [`crate::analysis::blf_sensitivity::TimeShell`]).
+    pub shell: Option<crate::analysis::blf_sensitivity::TimeShell>,
 }
 
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
@@ -340,7 +343,10 @@ pub const RESOLVE_TOLERANCE: f64 = 1e-8;
 impl TimeBuckling<'_> {
     /// λ and (∂λ/∂E₀, ∂λ/∂Ė, ∂λ/∂s) at the point `x` (nominal values where None), s = v₀/v
     /// the factor on every print duration.
-    fn solve(&self, x: Option<&[f64]>) -> Result<(f64, [f64; 3]), kappe_reliability::EvalError> {
+    fn solve(
+        &mut self,
+        x: Option<&[f64]>,
+    ) -> Result<(f64, [f64; 3]), kappe_reliability::EvalError> {
         let top = self.check.2;
         let (time, scale) = match x {
             Some(x) => (self.vars.time_at(&self.time, x), self.vars.age_scale(x)),
@@ -352,16 +358,15 @@ impl TimeBuckling<'_> {
         } else {
             Vec::new()
         };
-        crate::analysis::blf_sensitivity::time_state_blf_ages(
-            self.cap,
-            self.options,
-            &ages,
-            &dages,
-            &time,
-            top,
-            RESOLVE_TOLERANCE,
-        )?
-        .ok_or_else(|| {
+        if self.shell.is_none() {
+            self.shell =
+                crate::analysis::blf_sensitivity::TimeShell::new(self.cap, self.options, top)?;
+        }
+        let solved = match &mut self.shell {
+            Some(shell) => shell.solve(&ages, &dages, &time, RESOLVE_TOLERANCE)?,
+            None => None,
+        };
+        solved.ok_or_else(|| {
             format!(
                 "state {top}: no positive buckling factor at E₀ = {} Pa, Ė = {} Pa/s, print \
                  durations × {scale}",
@@ -902,6 +907,7 @@ pub fn state_form(
                     blf_min: k.blf_min,
                     shell0: None,
                     last: None,
+                    shell: None,
                 }),
                 _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
                     limit_state(check, v, limits, x, grad)
