@@ -135,6 +135,10 @@ pub enum Check {
         s_nu: f64,
         /// Top print index of the state.
         top: usize,
+        /// λ of the state's shell (the re-solves' mesh) at the design's values when the
+        /// deterministic analysis already solved it (its print-layer mesh factor, `blf_mesh`):
+        /// the ratio's denominator without a re-solve.
+        shell0: Option<f64>,
     },
 }
 
@@ -499,6 +503,26 @@ fn state_checks(
                 strength: s.strength_utilisation,
             },
         )?;
+        // The deterministic analysis solved the re-solves' shell at the design's values (the
+        // same mesh: grading, row stride, element; the same moduli): its factor is the
+        // ratio's denominator (test `reliability::analysis_factor_is_the_resolve_at_the_mean`).
+        let mesh = s.blf_mesh.or(if analysis.options.converged_blf {
+            None
+        } else {
+            s.blf
+        });
+        let checks = checks
+            .into_iter()
+            .map(|c| match c {
+                Check::BucklingTime { blf, s_nu, top, .. } => Check::BucklingTime {
+                    blf,
+                    s_nu,
+                    top,
+                    shell0: mesh,
+                },
+                c => c,
+            })
+            .collect();
         out.push((s.index, t_hours, checks));
     }
     Ok(out)
@@ -565,6 +589,7 @@ pub fn checks_of(
                 blf,
                 s_nu,
                 top: s.index,
+                shell0: None,
             }
         } else {
             Check::Buckling { blf, s_nu }
@@ -897,7 +922,15 @@ pub fn state_form(
         named.push((
             check.name(),
             match (check, &time) {
-                (Check::BucklingTime { blf, s_nu, top }, Some(time)) => Box::new(TimeBuckling {
+                (
+                    Check::BucklingTime {
+                        blf,
+                        s_nu,
+                        top,
+                        shell0,
+                    },
+                    Some(time),
+                ) => Box::new(TimeBuckling {
                     cap,
                     options,
                     schedule,
@@ -905,7 +938,7 @@ pub fn state_form(
                     vars: v,
                     check: (blf, s_nu, top),
                     blf_min: k.blf_min,
-                    shell0: None,
+                    shell0,
                     last: None,
                     shell: None,
                 }),
