@@ -512,7 +512,8 @@ impl BucklingSolver {
         model: &ShellModel,
         options: &BucklingOptions,
     ) -> Result<BucklingResult, FeError> {
-        self.buckling_cases(model, options, &[]).map(|(r, _)| r)
+        self.buckling_cases(model, options, &|_| Vec::new())
+            .map(|(r, _)| r)
     }
 
     /// [`BucklingSolver::buckling`] and a second load case solved with the same factor of K:
@@ -567,7 +568,7 @@ impl BucklingSolver {
                 });
             }
         }
-        let (r, solved) = self.buckling_cases(model, options, cases)?;
+        let (r, solved) = self.buckling_cases(model, options, &|_| cases.to_vec())?;
         if solved.len() != cases.len() {
             return Err(FeError::Numerical {
                 stage: "load cases",
@@ -577,11 +578,28 @@ impl BucklingSolver {
         Ok((r, solved))
     }
 
+    /// [`BucklingSolver::buckling_with_cases`] with the further load cases made from the
+    /// pre-buckling static solution by `cases`, and solved with the same factor of K: e.g. the
+    /// loads −(∂K/∂p)·u of the displacement sensitivities ∂u/∂p a buckling factor's exact
+    /// derivative needs (kappe's docs/reliability.md), one triangular solve each instead of a
+    /// factorization.
+    ///
+    /// # Errors
+    /// As [`BucklingSolver::buckling_with_cases`].
+    pub fn buckling_with_derived_cases(
+        &self,
+        model: &ShellModel,
+        options: &BucklingOptions,
+        cases: &dyn Fn(&StaticResult) -> Vec<LoadCase>,
+    ) -> Result<(BucklingResult, Vec<StaticResult>), FeError> {
+        self.buckling_cases(model, options, cases)
+    }
+
     fn buckling_cases(
         &self,
         model: &ShellModel,
         options: &BucklingOptions,
-        cases: &[LoadCase],
+        cases: &dyn Fn(&StaticResult) -> Vec<LoadCase>,
     ) -> Result<(BucklingResult, Vec<StaticResult>), FeError> {
         self.check(model)?;
         if options.modes == 0 {
@@ -611,8 +629,16 @@ impl BucklingSolver {
             kvals,
             geo,
         } = self.static_internal(model, &mut stats)?;
+        let cases = cases(&static_result);
         let mut solved = Vec::with_capacity(cases.len());
-        for c in cases {
+        for c in &cases {
+            if !c.weight.is_empty() && c.weight.len() != model.triangles.len() {
+                return Err(FeError::BadOption {
+                    field: "weight (one entry per triangle)",
+                    value: c.weight.len() as f64,
+                    allowed: "none, or as many entries as the model has triangles",
+                });
+            }
             let mut only = model.clone();
             only.materials = (0..model.triangles.len())
                 .map(|e| {

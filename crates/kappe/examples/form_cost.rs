@@ -52,6 +52,21 @@ fn cap(strength: bool) -> Result<Design, Box<dyn std::error::Error>> {
     Ok(Design::from_toml_str(&text)?)
 }
 
+/// The default cap (`kappe init`'s design) with a linear time model E(t) = 10 MPa + 1 kPa/s·t
+/// (the default E at age 0, stiffening by 3.6 MPa an hour) and the issue's kind of input: E₀
+/// (lognormal, cov 0.2), Ė (lognormal, cov 0.3), γ (normal, cov 0.05), E₀ drifting −20 %/h.
+fn default_cap() -> Result<Design, Box<dyn std::error::Error>> {
+    let text = "name = \"default\"\n[material.time]\nmodel = \"linear\"\n\
+                youngs_modulus = 1.0e7\nyoungs_modulus_rate = 1000.0\n\
+                [uncertainty]\n\
+                \"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.2 }\n\
+                \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+                \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+                [uncertainty.drift]\n\
+                \"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n";
+    Ok(Design::from_toml_str(text)?)
+}
+
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
@@ -66,8 +81,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "row | det. analysis wall s | nominal run CPU s | reliability wall s | CPU s | \
          ratio wall | ratio CPU | components | print β | load"
     );
-    for (name, strength) in [("time parameters", false), ("+ strength, speed", true)] {
-        let d = cap(strength)?;
+    // `form_cost [repeats] [rows]`: rows a list of 1 (study No. 14, time parameters), 2 (+
+    // strength, speed), 3 (the default cap, time parameters); default all.
+    let rows = std::env::args().nth(2).unwrap_or_else(|| "123".into());
+    let all = [
+        ("study 14, time parameters", '1'),
+        ("study 14, + strength, speed", '2'),
+        ("default cap, time parameters", '3'),
+    ];
+    for (name, row) in all.into_iter().filter(|(_, r)| rows.contains(*r)) {
+        let d = match row {
+            '1' => cap(false)?,
+            '2' => cap(true)?,
+            _ => default_cap()?,
+        };
         let mut nominal = d.clone();
         nominal.uncertainty = None;
         let cap = design_cap(&d, kappe::Context::default())?;

@@ -400,3 +400,45 @@ fn a_nodal_load_case_is_the_static_solution_of_those_loads_alone() {
     };
     assert!(solver.buckling_with_cases(&m, &fast(1), &[bad]).is_err());
 }
+
+/// `buckling_with_derived_cases` (kappe's buckling sensitivities, issue 24): a case made from
+/// the pre-buckling static solution — here a load proportional to its displacements, as the
+/// sensitivity load −(∂K/∂p)·u is — is the linear static solution of the model without gravity
+/// under that load alone, bit for bit (same K, ordering and right-hand side), and the buckling
+/// result is the plain solve's.
+#[test]
+fn a_derived_case_is_the_static_solution_of_its_loads_alone() {
+    use kappe_fe::{LoadCase, NodalLoad, StaticResult};
+    let m = kappe_fe::generate::barrel_vault(10, 6);
+    let solver = BucklingSolver::new(&m).unwrap();
+    let make = |st: &StaticResult| -> Vec<NodalLoad> {
+        st.displacements
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| d.iter().any(|v| *v != 0.0))
+            .map(|(node, d)| NodalLoad {
+                node,
+                force: [1e3 * d[0], -2e3 * d[1], 1e3 * d[2]],
+                moment: [0.0, 1e2 * d[4], 0.0],
+            })
+            .collect()
+    };
+    let cases = |st: &StaticResult| {
+        vec![LoadCase {
+            weight: Vec::new(),
+            nodal_loads: make(st),
+        }]
+    };
+    let (r, solved) = solver
+        .buckling_with_derived_cases(&m, &fast(1), &cases)
+        .unwrap();
+    let loads = make(&r.static_result);
+    assert!(!loads.is_empty(), "the static solution has no displacement");
+    let mut alone = m.clone();
+    alone.gravity = [0.0; 3];
+    alone.nodal_loads = loads;
+    assert_eq!(solved, vec![kappe_fe::linear_static(&alone).unwrap()]);
+    let plain = solver.buckling(&m, &fast(1)).unwrap();
+    assert_eq!(r.factors, plain.factors);
+    assert_eq!(r.static_result, plain.static_result);
+}

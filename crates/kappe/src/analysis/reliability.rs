@@ -135,6 +135,10 @@ pub enum Check {
         s_nu: f64,
         /// Top print index of the state.
         top: usize,
+        /// λ of the state's shell (the re-solves' mesh) at the design's values when the
+        /// deterministic analysis already solved it (its print-layer mesh factor, `blf_mesh`):
+        /// the ratio's denominator without a re-solve.
+        shell0: Option<f64>,
     },
 }
 
@@ -331,6 +335,9 @@ pub struct TimeBuckling<'a> {
     /// and then for g and its gradient at the same point once it is accepted; one re-solve
     /// (eigensolve and sensitivity solves) serves both, and the numbers are the same.
     pub last: Option<(Vec<f64>, f64, Vec<f64>)>,
+    /// The state's shell and solver, built on first use and kept for every iterate (see
+    /// [`crate::analysis::blf_sensitivity::TimeShell`]).
+    pub shell: Option<crate::analysis::blf_sensitivity::TimeShell>,
 }
 
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
@@ -340,7 +347,10 @@ pub const RESOLVE_TOLERANCE: f64 = 1e-8;
 impl TimeBuckling<'_> {
     /// λ and (∂λ/∂E₀, ∂λ/∂Ė, ∂λ/∂s) at the point `x` (nominal values where None), s = v₀/v
     /// the factor on every print duration.
-    fn solve(&self, x: Option<&[f64]>) -> Result<(f64, [f64; 3]), kappe_reliability::EvalError> {
+    fn solve(
+        &mut self,
+        x: Option<&[f64]>,
+    ) -> Result<(f64, [f64; 3]), kappe_reliability::EvalError> {
         let top = self.check.2;
         let (time, scale) = match x {
             Some(x) => (self.vars.time_at(&self.time, x), self.vars.age_scale(x)),
@@ -352,16 +362,15 @@ impl TimeBuckling<'_> {
         } else {
             Vec::new()
         };
-        crate::analysis::blf_sensitivity::time_state_blf_ages(
-            self.cap,
-            self.options,
-            &ages,
-            &dages,
-            &time,
-            top,
-            RESOLVE_TOLERANCE,
-        )?
-        .ok_or_else(|| {
+        if self.shell.is_none() {
+            self.shell =
+                crate::analysis::blf_sensitivity::TimeShell::new(self.cap, self.options, top)?;
+        }
+        let solved = match &mut self.shell {
+            Some(shell) => shell.solve(&ages, &dages, &time, RESOLVE_TOLERANCE)?,
+            None => None,
+        };
+        solved.ok_or_else(|| {
             format!(
                 "state {top}: no positive buckling factor at E₀ = {} Pa, Ė = {} Pa/s, print \
                  durations × {scale}",
@@ -494,6 +503,26 @@ fn state_checks(
                 strength: s.strength_utilisation,
             },
         )?;
+        // The deterministic analysis solved the re-solves' shell at the design's values (the
+        // same mesh: grading, row stride, element; the same moduli): its factor is the
+        // ratio's denominator (test `reliability::analysis_factor_is_the_resolve_at_the_mean`).
+        let mesh = s.blf_mesh.or(if analysis.options.converged_blf {
+            None
+        } else {
+            s.blf
+        });
+        let checks = checks
+            .into_iter()
+            .map(|c| match c {
+                Check::BucklingTime { blf, s_nu, top, .. } => Check::BucklingTime {
+                    blf,
+                    s_nu,
+                    top,
+                    shell0: mesh,
+                },
+                c => c,
+            })
+            .collect();
         out.push((s.index, t_hours, checks));
     }
     Ok(out)
@@ -560,6 +589,7 @@ pub fn checks_of(
                 blf,
                 s_nu,
                 top: s.index,
+                shell0: None,
             }
         } else {
             Check::Buckling { blf, s_nu }
@@ -892,7 +922,15 @@ pub fn state_form(
         named.push((
             check.name(),
             match (check, &time) {
-                (Check::BucklingTime { blf, s_nu, top }, Some(time)) => Box::new(TimeBuckling {
+                (
+                    Check::BucklingTime {
+                        blf,
+                        s_nu,
+                        top,
+                        shell0,
+                    },
+                    Some(time),
+                ) => Box::new(TimeBuckling {
                     cap,
                     options,
                     schedule,
@@ -900,8 +938,9 @@ pub fn state_form(
                     vars: v,
                     check: (blf, s_nu, top),
                     blf_min: k.blf_min,
-                    shell0: None,
+                    shell0,
                     last: None,
+                    shell: None,
                 }),
                 _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
                     limit_state(check, v, limits, x, grad)

@@ -360,6 +360,48 @@ fn study14(percent_per_hour: Option<f64>) -> Design {
     d
 }
 
+/// FORM's time-parameter buckling components take the ratio's denominator, λ of the state's
+/// shell at the design's values, from the deterministic analysis (its print-layer mesh factor
+/// `blf_mesh`) instead of a re-solve: the two are the same shell (grading, row stride, element,
+/// the moduli at the schedule's ages). Every analysed state of study No. 14's cap: the re-solve
+/// (Lanczos residual 1e-10) equals `blf_mesh` within 1e-5 relative, the analysis' own Lanczos
+/// residual with the mesh error controlled (a Ritz value lies within its relative residual of
+/// an eigenvalue); a different mesh or moduli would differ by far more (a row stride of 8
+/// against 4 moves λ by percents).
+#[test]
+fn analysis_factor_is_the_resolve_at_the_mean() {
+    let mut d = study14(Some(-20.0));
+    d.analysis.states = StateSelection::All;
+    d.uncertainty = None;
+    let out = run(&d, &Options::of(&d), &no_progress).unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let time = d.time_model().unwrap();
+    let (mut checked, mut worst) = (0, 0.0_f64);
+    for s in &analysis.states {
+        let Some(mesh) = s.blf_mesh else { continue };
+        let (l, _) = kappe::analysis::time_state_blf(
+            &cap,
+            &analysis.options,
+            &out.schedule,
+            &time,
+            s.index,
+            1e-10,
+        )
+        .unwrap()
+        .unwrap();
+        assert!(
+            (l / mesh - 1.0).abs() < 1e-5,
+            "state {}: re-solve {l} vs the analysis' blf_mesh {mesh}",
+            s.index
+        );
+        worst = worst.max((l / mesh - 1.0).abs());
+        checked += 1;
+    }
+    eprintln!("{checked} states: largest relative difference {worst:.2e}");
+    assert!(checked > 30, "only {checked} states had a mesh factor");
+}
+
 /// Study No. 14's story (the paper: a cap that met every constraint collapsed as the mix dried
 /// over the testing period). The cap passes on nominal values and keeps β ≥ β_min = 2.3 with a
 /// steady mix; a mix drying at −20 %/h (E₀ falls 19 % over the print) pulls the last states'
@@ -465,6 +507,7 @@ fn form_of_a_time_parameter_state_agrees_with_monte_carlo() {
         blf: blf0,
         s_nu: 0.0,
         top: q,
+        shell0: None,
     };
     let (state, results) = state_form(
         &cap,
@@ -782,5 +825,78 @@ fn print_speed_sensitivity_of_a_cap_state() {
     assert!(
         (scaled / direct - 1.0).abs() < 1e-9,
         "scaled ages λ {scaled} vs the faster print's schedule {direct}"
+    );
+}
+
+/// FORM of a cap state's strength and sliding components (one per layer and check, g = −ln u_k)
+/// against crude Monte Carlo of the same limit states (issue 24's check by sampling), the last
+/// state of the small cap with γ (normal, cov 0.05), f₀ (lognormal, 0.15), φ (lognormal, 0.1)
+/// and the print speed (lognormal, 0.1) uncertain and f(t) = 24 kPa + 3 Pa/s·t, φ = 20°. The
+/// state's FORM P_f is the series system of its components (importance sampling around their
+/// design points, 4 000 samples); the Monte Carlo fails a sample when any component's g ≤ 0
+/// (10⁴ seeded samples, Wilson 95 % interval). The FORM P_f lies in the interval. (ḟ is held:
+/// with it the capacity f₀ + ḟ·a of two lognormals is curved in u-space and FORM's
+/// first-order error shows, as on the buildability cylinder: docs/reliability.md, Limits.)
+#[test]
+fn form_of_the_strength_components_agrees_with_monte_carlo() {
+    let d = green_cap(0.0, 2.4e4, 3.0, 20.0);
+    let table = "\"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+                 \"material.time.compressive_strength\" = { dist = \"lognormal\", cov = 0.15 }\n\
+                 \"material.time.friction_angle_deg\" = { dist = \"lognormal\", cov = 0.1 }\n\
+                 \"print.print_speed\" = { dist = \"lognormal\", cov = 0.1 }\n";
+    let du = uncertain(&d, table);
+    let cap = design_cap(&du, kappe::Context::default()).unwrap();
+    let (model, drifts, v) = prepare(&cap).unwrap().unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
+    let time = du.time_model().unwrap();
+    let last = cap.states.len() - 1;
+    let (state, results) = kappe::analysis::state_form(
+        &cap,
+        &du.analysis,
+        &green.schedule,
+        (&model, &drifts, v),
+        last,
+        0.0,
+        &[Check::GreenLayers(1.0)],
+    )
+    .unwrap()
+    .unwrap();
+    assert!(
+        results.iter().any(|(n, _)| *n == "strength") && results.len() > 2,
+        "components: {:?}",
+        results.iter().map(|(n, r)| (n, r.beta)).collect::<Vec<_>>()
+    );
+    let field = GreenField::solve(&cap, &du.analysis, &green.schedule, last)
+        .unwrap()
+        .unwrap();
+    let mut comps = field.components(v, &time);
+    let mut g = |x: &[f64]| {
+        comps
+            .iter_mut()
+            .map(|(_, c)| c.value(x).unwrap())
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mc = monte_carlo(&model, &mut g, &SamplingOptions::new(10_000, 33)).unwrap();
+    eprintln!(
+        "state {last}: {} components, FORM P_f {} (β {}), Monte Carlo {} {:?}",
+        results.len(),
+        state.pf,
+        state.beta,
+        mc.pf,
+        mc.interval
+    );
+    assert!(
+        mc.pf > 0.005 && mc.pf < 0.5,
+        "an informative P_f: MC {mc:?}, FORM {} (β {})",
+        state.pf,
+        state.beta
+    );
+    assert!(
+        state.pf >= mc.interval[0] && state.pf <= mc.interval[1],
+        "FORM P_f {} (β {}) vs Monte Carlo {} {:?}",
+        state.pf,
+        state.beta,
+        mc.pf,
+        mc.interval
     );
 }
