@@ -217,11 +217,12 @@ pub struct StateEntry {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bottom_age_s: Option<f64>,
     /// Collapse factor of the imperfect state (only the states the collapse check ran,
-    /// docs/collapse.md).
+    /// docs/collapse.md); with `collapse_mode = "not_reached"` a lower bound.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collapse_factor: Option<f64>,
     /// What ends its path there: `limit_point`, `strength`, `sliding`, `mechanism`,
-    /// `not_reached`, `no_convergence`.
+    /// `no_convergence`, or `not_reached` (the path passed 1.5 λ_LBA, or the least collapse
+    /// factor of the states run before it, so it cannot govern: docs/collapse.md §3).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub collapse_mode: Option<String>,
     /// As-printed crown sag after this state, m (docs/as-printed.md: the largest downward
