@@ -29,7 +29,7 @@ export async function openDesigner(page_path) {
 
 // Wait until every state's buckling factor is in; the state.
 // The full verdict includes the mesh-error pass (the 2×2 split on a sample of the states,
-// solved in turn on the page's thread once every state is in): minutes on a loaded CI machine.
+// solved in the Web Workers batch by batch once every state is in): minutes on a loaded machine.
 export async function complete(page, timeout = 600000) {
   await page.waitForFunction(
     () => {
