@@ -14,6 +14,43 @@ fn cylinder(nonlinear: &str) -> Resolved {
         .unwrap()
 }
 
+/// The `n`-layer state of `r` with every element's modulus at its layer's age (the green
+/// check's model, as `kappe buildability` builds it), with its elements' layers and the ages.
+fn aged_state(
+    r: &Resolved,
+    n: usize,
+) -> (
+    kappe_fe::ShellModel,
+    Vec<kappe::analysis::ElementLayers>,
+    Vec<f64>,
+) {
+    use kappe::analysis::{GreenOptions, check_state};
+    let (mut model, layers) = kappe::commands::buildability::object_shell(r, n);
+    let ages = r.schedule.ages(n);
+    check_state(
+        &mut model,
+        &layers,
+        &ages,
+        &r.time,
+        &GreenOptions::default(),
+        None,
+    )
+    .unwrap();
+    (model, layers, ages)
+}
+
+/// The lowest linear buckling factor and mode of `model`.
+fn lowest_mode(model: &kappe_fe::ShellModel) -> kappe_fe::BucklingResult {
+    kappe_fe::buckling(
+        model,
+        &kappe_fe::BucklingOptions {
+            modes: 1,
+            ..Default::default()
+        },
+    )
+    .unwrap()
+}
+
 #[test]
 fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
     // 12 layers on the example's own 48 segments, the material check off: the path ends at
@@ -69,32 +106,11 @@ fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
 /// −0.42 %; without the facets' local von Kármán terms +4.9 % on all three).
 #[test]
 fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
-    use kappe::analysis::{GreenOptions, check_state};
-    use kappe::commands::buildability::object_shell;
-    use kappe_fe::{BucklingOptions, Linearisation, buckling, linearised_critical_factor};
-    let n = 12;
+    use kappe_fe::{Linearisation, linearised_critical_factor};
     let r = BuildabilitySpec::from_toml_str(EXAMPLE_TOML).unwrap();
-    let (mut model, layers) = object_shell(&r, n);
-    let ages = r.schedule.ages(n);
-    check_state(
-        &mut model,
-        &layers,
-        &ages,
-        &r.time,
-        &GreenOptions::default(),
-        None,
-    )
-    .unwrap();
+    let (model, _, _) = aged_state(&r, 12);
     let model = kappe_fe::refine::split(&model, 2).model;
-    let lba = buckling(
-        &model,
-        &BucklingOptions {
-            modes: 1,
-            ..Default::default()
-        },
-    )
-    .unwrap()
-    .factors[0];
+    let lba = lowest_mode(&model).factors[0];
     let sigma = linearised_critical_factor(
         &model,
         lba,
@@ -308,30 +324,10 @@ fn a_straight_wall_runs_one_sign() {
 /// docs/collapse.md §4).
 #[test]
 fn the_fast_path_finds_the_full_paths_collapse_factor() {
-    use kappe::analysis::{CollapseOptions, GreenOptions, check_state, collapse_factor};
-    use kappe::commands::buildability::object_shell;
-    use kappe_fe::{BucklingOptions, buckling};
-    let n = 12;
+    use kappe::analysis::{CollapseOptions, collapse_factor};
     let r = cylinder("material = false");
-    let (mut model, layers) = object_shell(&r, n);
-    let ages = r.schedule.ages(n);
-    check_state(
-        &mut model,
-        &layers,
-        &ages,
-        &r.time,
-        &GreenOptions::default(),
-        None,
-    )
-    .unwrap();
-    let b = buckling(
-        &model,
-        &BucklingOptions {
-            modes: 1,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let (model, layers, ages) = aged_state(&r, 12);
+    let b = lowest_mode(&model);
     let (lba, mode) = (b.factors[0], &b.modes[0]);
     let run = |w0: f64, fast_path: bool| {
         collapse_factor(
@@ -389,30 +385,10 @@ fn the_fast_path_finds_the_full_paths_collapse_factor() {
 /// factorizations than the full path.
 #[test]
 fn a_path_stops_above_the_least_collapse_factor_with_a_lower_bound() {
-    use kappe::analysis::{CollapseOptions, GreenOptions, check_state, collapse_factor};
-    use kappe::commands::buildability::object_shell;
-    use kappe_fe::{BucklingOptions, buckling};
-    let n = 12;
+    use kappe::analysis::{CollapseOptions, collapse_factor};
     let r = cylinder("material = false");
-    let (mut model, layers) = object_shell(&r, n);
-    let ages = r.schedule.ages(n);
-    check_state(
-        &mut model,
-        &layers,
-        &ages,
-        &r.time,
-        &GreenOptions::default(),
-        None,
-    )
-    .unwrap();
-    let b = buckling(
-        &model,
-        &BucklingOptions {
-            modes: 1,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let (model, layers, ages) = aged_state(&r, 12);
+    let b = lowest_mode(&model);
     let run = |stop_above: f64| {
         collapse_factor(
             &model,
