@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::analysis::buckling::state_material;
 use crate::analysis::shell::{NoShell, StateShell, state_shell};
 use crate::form::cap::Cap;
-use crate::form::states::{Role, build_state};
+use crate::form::states::Role;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 
@@ -207,8 +207,7 @@ pub fn cap_increment(
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
 ) -> Result<Increment, DesignError> {
-    let phi = cap.design.print.start_arch_fraction;
-    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+    let state = cap.state(top)?;
     let mat = state_material(cap, options, top, green);
     let shell = match state_shell(&state, &mat, 1) {
         Ok(s) => s,

@@ -30,7 +30,6 @@ use super::AnalysisOptions;
 use super::graded::AnalysedState;
 use super::shell::{ShellMaterial, state_shell};
 use crate::form::cap::Cap;
-use crate::form::states::build_state;
 use crate::input::error::DesignError;
 use crate::input::material::{TimeLaw, TimeModel};
 use crate::schedule::Schedule;
@@ -331,12 +330,7 @@ impl TimeShell {
         options: &AnalysisOptions,
         top: usize,
     ) -> Result<Option<TimeShell>, DesignError> {
-        let state = build_state(
-            &cap.sections,
-            &cap.frame,
-            cap.design.print.start_arch_fraction,
-            top,
-        )?;
+        let state = cap.state(top)?;
         let analysed = AnalysedState::new(&state, options.grading.as_ref());
         let d = &cap.design;
         // The moduli are set per solve; the mesh does not depend on them.

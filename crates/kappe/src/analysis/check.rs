@@ -14,7 +14,6 @@ use super::buckling::{
     state_material,
 };
 use crate::form::cap::Cap;
-use crate::form::states::build_state;
 use crate::form::stresses::{STRESS_REL_TOL, StressExtremes};
 use crate::input::analysis::AnalysisOptions;
 use crate::input::context::Context;
@@ -411,8 +410,7 @@ pub fn state_fe(
     request: &FeRequest<'_>,
 ) -> Result<StateFeSolve, DesignError> {
     let t0 = Instant::now();
-    let phi = cap.design.print.start_arch_fraction;
-    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+    let state = cap.state(top)?;
     let green = request.green;
     let mat = state_material(cap, options, top, green);
     // With a strength model the buckling solve's own static solution gives the membrane
@@ -466,8 +464,7 @@ fn state_fe_refine(
     mode: &ModeGuess,
 ) -> Result<StateFe, DesignError> {
     let t0 = Instant::now();
-    let phi = cap.design.print.start_arch_fraction;
-    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+    let state = cap.state(top)?;
     let mat = state_material(cap, options, top, None);
     let convergence = super::buckling::state_refine(&state, &mat, options, coarse, mode)?;
     Ok(StateFe {
@@ -891,7 +888,6 @@ fn assemble(
     let design = &cap.design;
     let total = cap.states.len();
     let areas = cap.areas();
-    let phi = design.print.start_arch_fraction;
 
     struct PerState {
         bending: Option<BendingSummary>,
@@ -922,7 +918,7 @@ fn assemble(
             let (stresses, bending) = match known {
                 Some(known) => known,
                 None => {
-                    let state = build_state(&cap.sections, &cap.frame, phi, top)?;
+                    let state = cap.state(top)?;
                     // The bending part of the corrugation (`crate::analysis::bending`).
                     let mat = crate::analysis::buckling::state_material(
                         cap,

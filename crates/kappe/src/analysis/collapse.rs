@@ -489,12 +489,7 @@ pub fn cap_state_lba(
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
 ) -> Result<Option<StateLba>, DesignError> {
-    let state = crate::form::states::build_state(
-        &cap.sections,
-        &cap.frame,
-        cap.design.print.start_arch_fraction,
-        top,
-    )?;
+    let state = cap.state(top)?;
     let mat = crate::analysis::buckling::state_material(cap, options, top, green);
     let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
         return Ok(None);

@@ -67,7 +67,9 @@ pub use collapse::{
     cap_state_collapse, cap_state_lba, collapse_factor, object_as_printed_shift, shifted,
 };
 pub use graded::{Grading, graded_rows, graded_state};
-pub use green::{CapGreen, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli};
+pub use green::{
+    CapGreen, ElementLayers, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli,
+};
 pub use reliability::{
     Check, GreenField, Vars, check_form, limit_state, prepare, reliability, scaled_ages, state_form,
 };

@@ -36,7 +36,6 @@ use serde::{Deserialize, Serialize};
 use super::buckling::{state_buckling, state_material};
 use super::check::Analysis;
 use crate::form::cap::Cap;
-use crate::form::states::build_state;
 use crate::input::error::DesignError;
 use crate::input::material::{Strength, TimeModel};
 use crate::input::uncertainty::BETA_MIN_DEFAULT;
@@ -565,8 +564,7 @@ pub fn checks_of(
             let green = crate::analysis::green::CapGreen::with_schedule(cap, Some(schedule))?;
             let green =
                 (green.time.strength.is_some() || !green.time.is_constant()).then_some(green);
-            let phi = cap.design.print.start_arch_fraction;
-            let state = build_state(&cap.sections, &cap.frame, phi, s.index)?;
+            let state = cap.state(s.index)?;
             let mut mat = state_material(cap, options, s.index, green.as_ref());
             let mut f = [0.0; 2];
             for (k, sign) in [1.0, -1.0].into_iter().enumerate() {
@@ -667,12 +665,7 @@ impl GreenField {
         if green.time.strength.is_none() {
             return Ok(None);
         }
-        let state = build_state(
-            &cap.sections,
-            &cap.frame,
-            cap.design.print.start_arch_fraction,
-            top,
-        )?;
+        let state = cap.state(top)?;
         let mut material = state_material(cap, options, top, Some(&green));
         if !green.time.is_constant() {
             material.layer_modulus = green.layer_moduli(cap, top);

@@ -24,7 +24,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling, state_material};
 use crate::form::cap::{Cap, design_cap};
-use crate::form::states::build_state;
 use crate::input::design::Design;
 use crate::input::error::DesignError;
 
@@ -162,12 +161,11 @@ fn state_blfs(
     states: &[usize],
 ) -> Result<BTreeMap<usize, f64>, DesignError> {
     let total = cap.states.len();
-    let phi = cap.design.print.start_arch_fraction;
     let found: Vec<Option<(usize, f64)>> = states
         .par_iter()
         .filter(|&&s| s < total)
         .map(|&s| {
-            let st = build_state(&cap.sections, &cap.frame, phi, s)?;
+            let st = cap.state(s)?;
             let mat = state_material(
                 cap,
                 options,

@@ -31,7 +31,6 @@ use crate::analysis::buckling::state_material;
 use crate::analysis::green::{CapGreen, FailureMode};
 use crate::analysis::{AnalysisOptions, BucklingStatus, state_buckling};
 use crate::form::cap::Cap;
-use crate::form::states::build_state;
 use crate::input::error::DesignError;
 use crate::schedule::Schedule;
 
@@ -94,12 +93,7 @@ pub fn check_state_on(
     schedule: &Schedule,
     top: usize,
 ) -> Result<StateCheck, DesignError> {
-    let state = build_state(
-        &cap.sections,
-        &cap.frame,
-        cap.design.print.start_arch_fraction,
-        top,
-    )?;
+    let state = cap.state(top)?;
     let mut g = green.clone();
     g.schedule = schedule.clone();
     let mut material = state_material(cap, options, top, Some(&g));

@@ -75,6 +75,20 @@ pub struct Cap {
 }
 
 impl Cap {
+    /// The print state whose top layer has print index `top`, built as form-finding built it
+    /// (the cap's sections, frame and `print.start_arch_fraction`).
+    ///
+    /// # Errors
+    /// `top` is not a printed layer.
+    pub fn state(&self, top: usize) -> Result<State, DesignError> {
+        build_state(
+            &self.sections,
+            &self.frame,
+            self.design.print.start_arch_fraction,
+            top,
+        )
+    }
+
     /// Cross-section areas for stresses.
     pub fn areas(&self) -> Sections2D {
         areas(&self.design, &self.arch, &self.centre_arches)
