@@ -582,8 +582,10 @@ pub fn converge_fe(
     Ok(interpolated)
 }
 
-/// Single states solved with `options` in turn, each from a cold start (the convergence pass's
-/// solver in the browser, where there are no threads; natively they run in parallel).
+/// Single states solved with `options` in turn, each from a cold start: the mesh-error pass's
+/// solver when [`analyze`] is given first-pass results without [`Request::refined`]. (Solving
+/// every state itself, [`analyze`] runs the pass in parallel from the first pass's modes; the
+/// designer's workers make these same cold-start solves for each [`RefineBatch`].)
 ///
 /// # Errors
 /// A state that cannot be built or solved.
