@@ -305,6 +305,24 @@ mod tests {
         .unwrap()
     }
 
+    /// [`sample`] of `coarse` at the default tolerance (0.5 %) whose split solves are the exact
+    /// pairs of `ratio`: the result and the number of states solved on the split.
+    fn sample_exact(
+        coarse: &[(usize, f64)],
+        ratio: &dyn Fn(usize) -> f64,
+    ) -> (Vec<(usize, ConvergedFactor, bool)>, usize) {
+        let mut calls = 0usize;
+        let mut solve = |batch: &[usize]| -> Result<Vec<(usize, ConvergedFactor)>, ()> {
+            calls += batch.len();
+            Ok(batch
+                .iter()
+                .map(|&i| (i, exact(coarse[i].1, ratio(i))))
+                .collect())
+        };
+        let out = sample(coarse, 0.005, true, &mut solve).unwrap();
+        (out, calls)
+    }
+
     /// The relaxed test spends the budget where it may: a ratio that wobbles by more than
     /// `tolerance/10` between the probes is interpolated among states far above the governing
     /// one, but solved where every state could govern; either way every bracket covers the pair
@@ -317,15 +335,7 @@ mod tests {
         // `tolerance/10` and `tolerance/2`.
         let ratio = |i: usize| 0.997 + 5e-4 * (i as f64 * std::f64::consts::TAU / 24.0).sin();
         let run = |coarse: &Vec<(usize, f64)>, slack: f64| {
-            let mut calls = 0usize;
-            let mut solve = |batch: &[usize]| -> Result<Vec<(usize, ConvergedFactor)>, ()> {
-                calls += batch.len();
-                Ok(batch
-                    .iter()
-                    .map(|&i| (i, exact(coarse[i].1, ratio(i))))
-                    .collect())
-            };
-            let out = sample(coarse, 0.005, true, &mut solve).unwrap();
+            let (out, calls) = sample_exact(coarse, &ratio);
             assert_eq!(out.len(), n);
             let upper = out.iter().map(|o| o.1.upper).fold(f64::INFINITY, f64::min);
             for (i, c, solved) in &out {
@@ -369,15 +379,7 @@ mod tests {
             let smooth = 0.99 + 1e-4 * i as f64;
             if i >= 61 { smooth - 0.01 } else { smooth }
         };
-        let mut calls = 0usize;
-        let mut solve = |batch: &[usize]| -> Result<Vec<(usize, ConvergedFactor)>, ()> {
-            calls += batch.len();
-            Ok(batch
-                .iter()
-                .map(|&i| (i, exact(coarse[i].1, ratio(i))))
-                .collect())
-        };
-        let out = sample(&coarse, 0.005, true, &mut solve).unwrap();
+        let (out, calls) = sample_exact(&coarse, &ratio);
         assert_eq!(out.len(), n);
         assert!(calls < n / 2, "{calls} solves");
         for (i, c, solved) in &out {
