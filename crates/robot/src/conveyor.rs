@@ -493,25 +493,15 @@ pub fn tracking_program_files(
                 }
             }
         }
-        if targets != part.targets {
-            return Err(RobotError::Verification(vec![format!(
-                "{fname}: wrote {targets} motion targets, the part was sized for {}",
-                part.targets
-            )]));
-        }
-        let mut text = String::new();
-        let title = plan.mark.title();
-        text.push_str(&format!(
-            "# Kappe print program {}/{} for a UR10e on a moving base{} (conveyor tracking; generated, verified by kappe-robot)\n",
-            pi + 1,
-            n_parts,
-            if title.is_empty() {
-                String::new()
-            } else {
-                format!(" -- {title}")
-            }
-        ));
-        text.push_str(&plan.mark.header_lines());
+        let mut text = crate::program::program_head(
+            (&fname, targets, part.targets),
+            (pi, n_parts),
+            (
+                "a UR10e on a moving base",
+                "conveyor tracking; generated, verified by kappe-robot",
+            ),
+            &plan.mark,
+        )?;
         text.push_str(&format!(
             "# layers {}..{}, {} motion targets; starts at base travel {} m, plan time {} s to {} s\n",
             part.first_layer,

@@ -425,25 +425,12 @@ pub fn program_files(plan: &Plan, prefix: &str) -> Result<Vec<ProgramFile>, Robo
                 }
             }
         }
-        if targets != part.targets {
-            return Err(RobotError::Verification(vec![format!(
-                "{fname}: wrote {targets} motion targets, the part was sized for {}",
-                part.targets
-            )]));
-        }
-        let mut text = String::new();
-        let title = plan.mark.title();
-        text.push_str(&format!(
-            "# Kappe print program {}/{} for a UR10e{} (generated; verified by kappe-robot check)\n",
-            pi + 1,
-            n_parts,
-            if title.is_empty() {
-                String::new()
-            } else {
-                format!(" -- {title}")
-            }
-        ));
-        text.push_str(&plan.mark.header_lines());
+        let mut text = program_head(
+            (&fname, targets, part.targets),
+            (pi, n_parts),
+            ("a UR10e", "generated; verified by kappe-robot check"),
+            &plan.mark,
+        )?;
         text.push_str(&format!(
             "# station {}: base at x {:.3} m, y {:.3} m, yaw {:.1}° (stations.md); layers {} to {}, {} motion targets\n",
             part.station + 1 + plan.mark.station_offset,
@@ -569,4 +556,31 @@ pub fn resume_plan(plan: &Plan, layer: i64) -> Result<Plan, RobotError> {
     out.parts = split_parts(&out)?;
     crate::timing::apply_timing(&mut out, Some(&waits))?;
     Ok(out)
+}
+
+/// The first lines of program `pi + 1` of `n_parts` (`part`: its file, the motion targets
+/// written and those it was sized for, which must agree): the title naming the `robot` and
+/// `how` it was made, and the plan's mark.
+pub(crate) fn program_head(
+    (fname, wrote, sized): (&str, usize, usize),
+    (pi, n_parts): (usize, usize),
+    (robot, how): (&str, &str),
+    mark: &crate::plan::PlanMark,
+) -> Result<String, RobotError> {
+    if wrote != sized {
+        return Err(RobotError::Verification(vec![format!(
+            "{fname}: wrote {wrote} motion targets, the part was sized for {sized}"
+        )]));
+    }
+    let title = mark.title();
+    let title = if title.is_empty() {
+        String::new()
+    } else {
+        format!(" -- {title}")
+    };
+    Ok(format!(
+        "# Kappe print program {}/{n_parts} for {robot}{title} ({how})\n{}",
+        pi + 1,
+        mark.header_lines()
+    ))
 }
