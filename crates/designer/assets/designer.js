@@ -173,8 +173,13 @@
   const NWORKERS = Math.max(1, Math.min(2, navigator.hardwareConcurrency || 2));
   const workerUrl = URL.createObjectURL(new Blob([GLUE, '\n', WORKER_SRC], { type: 'text/javascript' }));
   let pool = [];
-  // Jobs: { run: [state indices], max_split } (1: the first pass; more: the mesh-error pass).
+  // Jobs: { run: [state indices], max_split, owner } (max_split 1: the first pass; more: the
+  // mesh-error pass, whose state goes to the worker that solved its first pass: it keeps that
+  // solve's mode and starts from it, as `kappe design` does; a worker with nothing of its own
+  // left takes the other's largest job and solves it cold).
   let queue = [];
+  // The worker that solved each state's first pass (this design).
+  let owner = new Map();
   // The mesh-error solves handed out for the current design ("state:split"): the pass names
   // what it still lacks, so a batch shrinks as its results come in and must not be sent twice.
   let sent = new Set();
@@ -200,15 +205,18 @@
       return w;
     });
     while (pool.length < NWORKERS) pool.push(spawn());
-    queue = res.runs.map((r) => ({ run: r.slice(), max_split: 1 }));
+    queue = res.runs.map((r) => ({ run: r.slice(), max_split: 1, owner: null }));
     sent = new Set();
+    owner = new Map();
     pool.forEach(feed);
     if (res.runs.length === 0) finished();
   }
   function feed(w) {
     if (w.busy || !queue.length || !current) return;
     w.busy = true;
-    const job = queue.shift();
+    let k = queue.findIndex((j) => j.owner === w || j.owner === null);
+    if (k < 0) k = 0;
+    const job = queue.splice(k, 1)[0];
     w.postMessage({ generation: current.generation, text: current.text, run: job.run, max_split: job.max_split });
   }
   // Once every first-pass factor is in, the mesh-error pass (kappe's `converge_fe`, replayed on
@@ -220,7 +228,7 @@
     todo.sort((a, b) => b - a);
     for (const i of todo) {
       sent.add(i + ':' + batch.max_split);
-      queue.push({ run: [i], max_split: batch.max_split });
+      queue.push({ run: [i], max_split: batch.max_split, owner: owner.get(i) || null });
     }
     pool.forEach(feed);
   }
@@ -234,6 +242,9 @@
       return;
     }
     if (!current || msg.generation !== current.generation) return;
+    if (msg.max_split === 1) {
+      for (const f of JSON.parse(msg.result)) owner.set(f.state, w);
+    }
     try {
       report = JSON.parse(session.add_fe(msg.generation, msg.result));
     } catch (e) {

@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 use kappe::analysis::WorstElement;
 use kappe::analysis::{BucklingStatus, ModeGuess, StateBuckling};
 use kappe::analysis::{RefineBatch, RefineSolves};
-use kappe::analysis::{StateFe, analysis_green, fe_runs, state_fe};
+use kappe::analysis::{StateFe, analysis_green, fe_runs, state_fe, state_fe_refine};
 use kappe::{Cap, Design, DesignError};
 use kappe_fe::{ConvergedFactor, MeshLevel};
 use serde::{Deserialize, Serialize};
@@ -507,13 +507,16 @@ fn view(cap: &Cap) -> Value {
     json!({ "xyz": xyz, "layer": layer, "members": members, "overhangs": cap.overhangs })
 }
 
-/// A Web Worker's share of the buckling analysis: the cap of the design it was given, and the
-/// warm start within the current run.
+/// A Web Worker's share of the buckling analysis: the cap of the design it was given, the warm
+/// start within the current run, and the first-pass factor and mode of every state it solved,
+/// from which it solves those states' mesh-error levels as `kappe design` does
+/// ([`state_fe_refine`]: no second print-layer solve, the split's eigen-solve warm-started).
 pub struct WorkerCore {
     text: String,
     cap: Option<Cap>,
     green: Option<kappe::analysis::CapGreen>,
     guess: Option<ModeGuess>,
+    first: BTreeMap<usize, (f64, ModeGuess)>,
 }
 
 impl Default for WorkerCore {
@@ -530,13 +533,15 @@ impl WorkerCore {
             cap: None,
             green: None,
             guess: None,
+            first: BTreeMap::new(),
         }
     }
 
     /// Analyse `run` (state indices of one [`fe_runs`] run, in order) of the design `text` with
     /// `blf_max_split = max_split` (1: the first pass, warm-started along the run; more: single
-    /// states of a [`RefineBatch`], each from a cold start as [`kappe::analysis::analyze`]
-    /// solves them); `on_state` hears each state's result as JSON ([`FeWire`]) as it finishes.
+    /// states of a [`RefineBatch`], each from the first pass's factor and mode if this worker
+    /// solved it, as [`kappe::analysis::analyze`] does, else from a cold start); `on_state`
+    /// hears each state's result as JSON ([`FeWire`]) as it finishes.
     ///
     /// # Errors
     /// The design's problem (the page checked it first) or a state that cannot be solved.
@@ -555,6 +560,7 @@ impl WorkerCore {
             self.green = analysis_green(&cap, Some(&schedule)).map_err(|e| FieldError::of(&e))?;
             self.cap = Some(cap);
             self.text = text.to_string();
+            self.first.clear();
         }
         let Some(cap) = &self.cap else {
             return Ok(());
@@ -573,15 +579,29 @@ impl WorkerCore {
                 green: self.green.as_ref(),
                 extra: false,
             };
-            let mut cold = None;
-            let guess = if max_split == 1 {
-                &mut self.guess
-            } else {
-                &mut cold
+            let fe = match (max_split, self.first.get(&i)) {
+                (1, _) => {
+                    let fe = state_fe(cap, &options, i, &mut self.guess, &request)
+                        .map_err(|e| FieldError::of(&e))?
+                        .fe;
+                    // What `analyze` keeps for its mesh-error pass (without a green-state
+                    // model, whose path starts cold).
+                    if let (None, Some(g), Some(&f1)) =
+                        (&self.green, &self.guess, fe.buckling.factors.first())
+                    {
+                        self.first.insert(i, (f1, g.clone()));
+                    }
+                    fe
+                }
+                (_, Some((f1, mode))) => {
+                    state_fe_refine(cap, &options, i, *f1, mode).map_err(|e| FieldError::of(&e))?
+                }
+                (_, None) => {
+                    state_fe(cap, &options, i, &mut None, &request)
+                        .map_err(|e| FieldError::of(&e))?
+                        .fe
+                }
             };
-            let fe = state_fe(cap, &options, i, guess, &request)
-                .map_err(|e| FieldError::of(&e))?
-                .fe;
             let wire = FeWire::of(&fe, max_split);
             on_state(serde_json::to_string(&[wire]).unwrap_or_default());
         }

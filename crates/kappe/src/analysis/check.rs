@@ -450,13 +450,14 @@ pub fn state_fe(
 }
 
 /// The mesh-error levels of state `top` from its first-pass factor `coarse` and mode `mode`
-/// ([`state_fe`] without a green-state model) with `options`, without
-/// solving the print-layer mesh again. Only `buckling.convergence` and `seconds` are meant to be
-/// read ([`converge_fe`]'s solver).
+/// ([`state_fe`] without a green-state model; `mode` is the `guess` it leaves) with `options`,
+/// without solving the print-layer mesh again. Only `buckling.convergence` and `seconds` are
+/// meant to be read ([`converge_fe`]'s solver: [`analyze`]'s, and the designer's workers for
+/// the states whose first pass they solved).
 ///
 /// # Errors
 /// A state that cannot be built or solved.
-fn state_fe_refine(
+pub fn state_fe_refine(
     cap: &Cap,
     options: &AnalysisOptions,
     top: usize,
@@ -584,8 +585,9 @@ pub fn converge_fe(
 
 /// Single states solved with `options` in turn, each from a cold start: the mesh-error pass's
 /// solver when [`analyze`] is given first-pass results without [`Request::refined`]. (Solving
-/// every state itself, [`analyze`] runs the pass in parallel from the first pass's modes; the
-/// designer's workers make these same cold-start solves for each [`RefineBatch`].)
+/// every state itself, [`analyze`] runs the pass in parallel from the first pass's modes
+/// ([`state_fe_refine`]); so do the designer's workers for a [`RefineBatch`]'s states whose first
+/// pass they solved, and these cold-start solves for the others.)
 ///
 /// # Errors
 /// A state that cannot be built or solved.

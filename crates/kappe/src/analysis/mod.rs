@@ -60,7 +60,7 @@ pub use blf_sensitivity::{blf_derivatives, time_state_blf, time_state_blf_ages};
 pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
 pub use check::{
     FeRequest, RefineBatch, RefineSolves, StateFe, StateFeSolve, analysis_green, fe_runs, levers,
-    state_fe,
+    state_fe, state_fe_refine,
 };
 pub use collapse::{
     CURVE_POINTS, CollapseMode, CollapseOptions, StateLba, cap_as_printed_shift,
