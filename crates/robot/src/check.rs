@@ -315,11 +315,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
         rep.max_speed_ratio = rep.max_speed_ratio.max(ratio_v);
         rep.max_acceleration_ratio = rep.max_acceleration_ratio.max(ratio_a);
     }
-    let n = problems.len();
-    if n > 20 {
-        problems.truncate(20);
-        problems.push(format!("… and {} more", n - 20));
-    }
+    crate::error::shorten(&mut problems, 20);
     rep.problems = problems;
     rep
 }

@@ -104,3 +104,13 @@ impl RobotError {
         }
     }
 }
+
+/// A report's problem list cut to its first `keep` entries and a line counting the rest: a
+/// plan that fails everywhere would otherwise print thousands of lines saying the same.
+pub(crate) fn shorten(problems: &mut Vec<String>, keep: usize) {
+    let n = problems.len();
+    if n > keep {
+        problems.truncate(keep);
+        problems.push(format!("… and {} more", n - keep));
+    }
+}

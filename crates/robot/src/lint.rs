@@ -834,11 +834,7 @@ pub fn lint_with_limits(text: &str, max_targets: usize, limits: &[[f64; 2]; 6]) 
     if uses_tracking(text) {
         problems.extend(tracking_form_problems(text));
     }
-    let n = problems.len();
-    if n > 50 {
-        problems.truncate(50);
-        problems.push(format!("… and {} more", n - 50));
-    }
+    crate::error::shorten(&mut problems, 50);
     rep.problems = problems;
     rep
 }

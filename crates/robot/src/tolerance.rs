@@ -105,11 +105,7 @@ pub fn check_base_tolerance(plan: &Plan, tol: &BaseTolerance) -> ToleranceReport
         }
         rep.problems.extend(r.problems);
     }
-    let n = rep.problems.len();
-    if n > 20 {
-        rep.problems.truncate(20);
-        rep.problems.push(format!("… and {} more", n - 20));
-    }
+    crate::error::shorten(&mut rep.problems, 20);
     rep
 }
 

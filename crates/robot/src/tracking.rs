@@ -469,11 +469,7 @@ pub fn simulate_tracking(
             rep.max_base_offset
         ));
     }
-    let n = rep.problems.len();
-    if n > 20 {
-        rep.problems.truncate(20);
-        rep.problems.push(format!("… and {} more", n - 20));
-    }
+    crate::error::shorten(&mut rep.problems, 20);
     rep.layers = layer_rep;
     Ok(rep)
 }

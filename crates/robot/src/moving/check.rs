@@ -101,12 +101,8 @@ pub fn check_moving(mp: &MovingPlan) -> MovingCheck {
         min_self_distance: f64::INFINITY,
         ..Default::default()
     };
-    let (ctx, geo) = match scene(mp) {
-        Ok(x) => x,
-        Err(e) => {
-            rep.problems.push(e);
-            return rep;
-        }
+    let Some((ctx, geo)) = scene(mp, &mut rep.problems) else {
+        return rep;
     };
     let plan = &mp.plan;
     let tool = match Iso::from_mat4(&plan.flange_from_tcp) {
@@ -275,11 +271,7 @@ pub fn check_moving(mp: &MovingPlan) -> MovingCheck {
             break;
         }
     }
-    let n = problems.len();
-    if n > 20 {
-        problems.truncate(20);
-        problems.push(format!("… and {} more", n - 20));
-    }
+    crate::error::shorten(&mut problems, 20);
     rep.problems = problems;
     rep
 }
@@ -358,12 +350,8 @@ pub fn check_moving_tolerance(
         ));
         return rep;
     }
-    let (ctx, geo) = match scene(mp) {
-        Ok(x) => x,
-        Err(e) => {
-            rep.problems.push(e);
-            return rep;
-        }
+    let Some((ctx, geo)) = scene(mp, &mut rep.problems) else {
+        return rep;
     };
     let plan = &mp.plan;
     let errors = sampled_errors(tol);
@@ -412,21 +400,22 @@ pub fn check_moving_tolerance(
         rep.min_clearance = rep.min_clearance.min(c);
         rep.problems.extend(pr);
     }
-    let n = rep.problems.len();
-    if n > 20 {
-        rep.problems.truncate(20);
-        rep.problems.push(format!("… and {} more", n - 20));
-    }
+    crate::error::shorten(&mut rep.problems, 20);
     rep
 }
 
-/// The planner's context and the moving scene of `mp`'s plan, or the problem that stops a check
-/// before it starts (the plan's shape, its input, its scene).
-fn scene(mp: &MovingPlan) -> Result<(Context, Geometry), String> {
-    mp.validate_shape().map_err(|e| e.to_string())?;
-    let plan = &mp.plan;
-    let ctx = validate(&plan_layers(plan), &plan.setup, &plan.options)
-        .map_err(|e| format!("invalid plan input: {e}"))?;
-    let geo = Geometry::new(&ctx).map_err(|e| format!("scene: {e}"))?;
-    Ok((ctx, geo))
+/// The planner's context and the moving scene of `mp`'s plan; `None` with the problem added to
+/// `problems` when a check cannot start (the plan's shape, its input, its scene).
+fn scene(mp: &MovingPlan, problems: &mut Vec<String>) -> Option<(Context, Geometry)> {
+    let built = mp
+        .validate_shape()
+        .map_err(|e| e.to_string())
+        .and_then(|()| {
+            let plan = &mp.plan;
+            let ctx = validate(&plan_layers(plan), &plan.setup, &plan.options)
+                .map_err(|e| format!("invalid plan input: {e}"))?;
+            let geo = Geometry::new(&ctx).map_err(|e| format!("scene: {e}"))?;
+            Ok((ctx, geo))
+        });
+    built.map_err(|e| problems.push(e)).ok()
 }
