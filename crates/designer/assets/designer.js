@@ -180,6 +180,15 @@
   let queue = [];
   // The worker that solved each state's first pass (this design).
   let owner = new Map();
+  // Results not yet handed to the session. Each hand-over re-evaluates the whole design (the
+  // verdict of every state so far) on this thread, which shares the two cores with the workers:
+  // results are handed over together, at most every FLUSH_MS while the workers have queued
+  // work, and at once when a worker waits or nothing is queued (the next mesh-error batch
+  // depends on them).
+  const FLUSH_MS = 400;
+  let pending = [];
+  let flushTimer = null;
+  let lastFlush = 0;
   // The mesh-error solves handed out for the current design ("state:split"): the pass names
   // what it still lacks, so a batch shrinks as its results come in and must not be sent twice.
   let sent = new Set();
@@ -208,6 +217,9 @@
     queue = res.runs.map((r) => ({ run: r.slice(), max_split: 1, owner: null }));
     sent = new Set();
     owner = new Map();
+    pending = [];
+    clearTimeout(flushTimer);
+    flushTimer = null;
     pool.forEach(feed);
     if (res.runs.length === 0) finished();
   }
@@ -239,14 +251,29 @@
         console.warn('designer worker: ' + msg.error);
       }
       feed(w);
+      if (pending.length && !w.busy) flush();
       return;
     }
     if (!current || msg.generation !== current.generation) return;
     if (msg.max_split === 1) {
       for (const f of JSON.parse(msg.result)) owner.set(f.state, w);
     }
+    pending.push(msg.result);
+    const starving = !queue.length || pool.some((x) => !x.busy);
+    const wait = lastFlush + FLUSH_MS - performance.now();
+    if (starving || wait <= 0) flush();
+    else if (flushTimer === null) flushTimer = setTimeout(flush, wait);
+  }
+  function flush() {
+    clearTimeout(flushTimer);
+    flushTimer = null;
+    if (!pending.length || !current) return;
+    // Each result is a JSON list of one state's FeWire: one list of them all.
+    const results = '[' + pending.map((r) => r.slice(1, -1)).filter((r) => r.length).join(',') + ']';
+    pending = [];
+    lastFlush = performance.now();
     try {
-      report = JSON.parse(session.add_fe(msg.generation, msg.result));
+      report = JSON.parse(session.add_fe(current.generation, results));
     } catch (e) {
       showError(parseErr(e));
       return;
