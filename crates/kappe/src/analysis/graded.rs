@@ -195,3 +195,42 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
     };
     (reduced, map)
 }
+
+/// The state's network on a mesh `c` times coarser in both directions (issue 25, the coarse-mesh
+/// screen of docs/convergence.md): every `c`-th layer row (anchored at print index 0, the first
+/// and the top row always, as [`crate::analysis::shell::state_shell`]'s `row_stride`) and every
+/// `c`-th node along each kept row (both feet kept, [`thinned`]'s nearly equal steps). `c` = 1
+/// is the state itself.
+pub fn coarsened_state(state: &State, c: usize) -> State {
+    let c = c.max(1);
+    let net = &state.network;
+    let rows = crate::analysis::shell::layer_rows(net);
+    let top = rows.len().saturating_sub(1);
+    let mut map: Vec<usize> = rows
+        .iter()
+        .enumerate()
+        .filter(|(q, _)| q % c == 0 || *q == top)
+        .flat_map(|(_, (_, row))| {
+            thinned(row.len(), c)
+                .into_iter()
+                .filter_map(|j| row.get(j).copied())
+        })
+        .collect();
+    map.sort_unstable();
+    State {
+        index: state.index,
+        layers_printed: state.layers_printed,
+        top_layer: state.top_layer,
+        progress: state.progress,
+        factors: state.factors.clone(),
+        column_force_per_weight: state.column_force_per_weight.clone(),
+        network: crate::form::states::Network {
+            nodes: map
+                .iter()
+                .filter_map(|&i| net.nodes.get(i).cloned())
+                .collect(),
+            trails: Vec::new(),
+            deviation_edges: Vec::new(),
+        },
+    }
+}
