@@ -23,9 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut design = match kind.as_str() {
         "smooth" => kappe::Design::default(),
-        "corrugated" => {
-            kappe::Design::from_toml_str(kappe::commands::templates::CORRUGATED_TOML)?
-        }
+        "corrugated" => kappe::Design::from_toml_str(kappe::commands::templates::CORRUGATED_TOML)?,
         other => return Err(format!("KIND {other}: smooth or corrugated").into()),
     };
     design.cap.length = length.parse()?;

@@ -234,3 +234,43 @@ pub fn coarsened_state(state: &State, c: usize) -> State {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 2h network of a default-cap state: the rows at even print index and the top row,
+    /// each with both feet and every other node between them (⌈(len − 1)/2⌉ steps), in the
+    /// network's own top-down order; c = 1 keeps the state.
+    #[test]
+    fn coarsened_state_keeps_every_other_row_and_node_and_the_feet() {
+        let cap = crate::design_cap(&crate::Design::default(), crate::Context::default())
+            .expect("the default design is valid");
+        let state = cap.state(21).expect("state 21 exists");
+        let rows = crate::analysis::shell::layer_rows(&state.network);
+        assert_eq!(
+            coarsened_state(&state, 1).network.nodes,
+            state.network.nodes
+        );
+        let coarse = coarsened_state(&state, 2);
+        let coarse_rows = crate::analysis::shell::layer_rows(&coarse.network);
+        let kept: Vec<&(i32, Vec<usize>)> = rows
+            .iter()
+            .enumerate()
+            .filter(|(q, _)| q % 2 == 0 || *q == rows.len() - 1)
+            .map(|(_, r)| r)
+            .collect();
+        assert_eq!(coarse_rows.len(), kept.len());
+        for ((id, full), (cid, thin)) in kept.iter().map(|r| (&r.0, &r.1)).zip(&coarse_rows) {
+            assert_eq!(id, cid);
+            assert_eq!(thin.len(), (full.len() - 1).div_ceil(2) + 1, "layer {id}");
+            let (Some(&f0), Some(&f1), Some(&c0), Some(&c1)) =
+                (full.first(), full.last(), thin.first(), thin.last())
+            else {
+                panic!("empty row {id}");
+            };
+            assert_eq!(coarse.network.nodes[c0].xyz, state.network.nodes[f0].xyz);
+            assert_eq!(coarse.network.nodes[c1].xyz, state.network.nodes[f1].xyz);
+        }
+    }
+}

@@ -73,4 +73,4 @@ pub use green::{
 pub use reliability::{
     Check, GreenField, Vars, check_form, limit_state, prepare, reliability, scaled_ages, state_form,
 };
-pub use shell::state_shell;
+pub use shell::{StateShell, state_shell};
