@@ -1298,6 +1298,13 @@ mod tests {
         for rank in [&reverse, &restricted] {
             let s = BucklingSolver::with_node_order(&small, rank).unwrap();
             assert_eq!(s.n_free_dofs(), amd.n_free_dofs());
+            // The order was used: nodes with free DOFs are eliminated in the given rank order.
+            let used = s.node_order();
+            let mut free: Vec<usize> = (0..small.nodes.len())
+                .filter(|&n| used[n] != usize::MAX)
+                .collect();
+            free.sort_by_key(|&n| rank[n]);
+            assert!(free.windows(2).all(|w| used[w[0]] < used[w[1]]));
             let f = s.buckling(&small, &opts).unwrap().factors[0];
             // Both Ritz values meet the residual bound 1e-8 on the same matrix; the eigenvalue
             // error is of the order of its square, so 1e-9 relative bounds the difference.

@@ -8,6 +8,8 @@
 //! (h,h/2) estimate 2λ_h/2 − λ_h that `kappe design` reports.
 //!
 //! `cargo run --release -p kappe --example blf_coarse -- KIND LENGTH STATE…`
+//! `COARSEN=rows` or `COARSEN=nodes` coarsens in one direction only (2h then means every other
+//! row, or every other node along each row).
 //! (KIND: `smooth` = `kappe init`, `corrugated` = `kappe init --kind corrugated`; LENGTH the
 //! cap length, m).
 
@@ -15,6 +17,13 @@ use std::time::Instant;
 
 use kappe::analysis::{AnalysisOptions, coarsened_state, state_material, state_shell};
 use kappe_fe::BucklingOptions;
+
+/// One mesh's factor, free DOFs and solve seconds.
+struct Level {
+    lambda: f64,
+    dofs: usize,
+    secs: f64,
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -47,45 +56,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let top: usize = a.parse()?;
         let state = cap.state(top)?;
         let material = state_material(&cap, &options, top, Some(&green));
-        let level = |c: usize| -> Result<(f64, usize, f64, Vec<[f64; 6]>), String> {
-            let s = coarsened_state(&state, c);
+        let level = |c: usize| -> Result<(Level, Option<Level>), String> {
+            let s = match std::env::var("COARSEN").as_deref() {
+                Ok("rows") => coarsened_state(&state, c, 1),
+                Ok("nodes") => coarsened_state(&state, 1, c),
+                _ => coarsened_state(&state, c, c),
+            };
             let shell = state_shell(&s, &material, 1).map_err(|e| format!("{e:?}"))?;
             let t = Instant::now();
             let r = kappe_fe::buckling(&shell.model, &opts).map_err(|e| format!("{e}"))?;
-            let secs = t.elapsed().as_secs_f64();
-            let mode = r.modes.first().cloned().unwrap_or_default();
-            if c == 1 {
-                // h/2: the split started from h's mode, as the mesh-error pass runs it.
-                let refined = kappe_fe::refine::split(&shell.model, 2);
-                let t = Instant::now();
-                let f = kappe_fe::buckling(
-                    &refined.model,
-                    &BucklingOptions {
-                        start: Some(refined.prolong(&mode)),
-                        ..opts.clone()
-                    },
-                )
-                .map_err(|e| format!("{e}"))?;
-                return Ok((
-                    r.factors[0],
-                    r.stats.n_free_dofs,
-                    secs,
-                    vec![[
-                        f.factors[0],
-                        f.stats.n_free_dofs as f64,
-                        t.elapsed().as_secs_f64(),
-                        0.0,
-                        0.0,
-                        0.0,
-                    ]],
-                ));
+            let coarse = Level {
+                lambda: r.factors[0],
+                dofs: r.stats.n_free_dofs,
+                secs: t.elapsed().as_secs_f64(),
+            };
+            if c > 1 {
+                return Ok((coarse, None));
             }
-            Ok((r.factors[0], r.stats.n_free_dofs, secs, Vec::new()))
+            // h/2: the split started from h's mode, as the mesh-error pass runs it.
+            let refined = kappe_fe::refine::split(&shell.model, 2);
+            let t = Instant::now();
+            let f = kappe_fe::buckling(
+                &refined.model,
+                &BucklingOptions {
+                    start: r.modes.first().map(|m| refined.prolong(m)),
+                    ..opts.clone()
+                },
+            )
+            .map_err(|e| format!("{e}"))?;
+            let fine = Level {
+                lambda: f.factors[0],
+                dofs: f.stats.n_free_dofs,
+                secs: t.elapsed().as_secs_f64(),
+            };
+            Ok((coarse, Some(fine)))
         };
-        let (l4, n4, t4, _) = level(4)?;
-        let (l2, n2, t2, _) = level(2)?;
-        let (l1, n1, t1, fine) = level(1)?;
-        let [lf, nf, tf, ..] = fine.first().copied().unwrap_or([f64::NAN; 6]);
+        let ((c4, _), (c2, _)) = (level(4)?, level(2)?);
+        let (c1, cf) = level(1)?;
+        let cf = cf.ok_or("no h/2 level")?;
+        let (l4, n4, t4) = (c4.lambda, c4.dofs, c4.secs);
+        let (l2, n2, t2) = (c2.lambda, c2.dofs, c2.secs);
+        let (l1, n1, t1) = (c1.lambda, c1.dofs, c1.secs);
+        let (lf, nf, tf) = (cf.lambda, cf.dofs, cf.secs);
         let mono = l2 >= l1 && l1 >= lf;
         let r21 = (l2 - l1) / (l1 - lf);
         let r42 = (l4 - l2) / (l2 - l1);
