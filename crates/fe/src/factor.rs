@@ -44,17 +44,33 @@ fn par() -> Par {
 
 impl Symbolic {
     pub(crate) fn new(p: &Pattern) -> Result<Self, FeError> {
-        let chol = factorize_symbolic_cholesky(
-            pattern_ref(p),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        )
-        .map_err(|e| FeError::Numerical {
-            stage: "symbolic Cholesky",
-            detail: format!("{e:?}"),
-        })?;
+        Self::ordered(p, None)
+    }
+
+    /// As [`Symbolic::new`] with a given fill-reducing ordering (`order[k]` = the free DOF
+    /// eliminated k-th; the caller has checked it is a permutation of `0..p.n`), or AMD.
+    pub(crate) fn ordered(
+        p: &Pattern,
+        order: Option<(&[usize], &[usize])>,
+    ) -> Result<Self, FeError> {
+        let ordering = match order {
+            Some((fwd, inv)) => {
+                SymmetricOrdering::Custom(faer::perm::PermRef::new_checked(fwd, inv, p.n))
+            }
+            None => SymmetricOrdering::Amd,
+        };
+        let chol =
+            factorize_symbolic_cholesky(pattern_ref(p), Side::Lower, ordering, Default::default())
+                .map_err(|e| FeError::Numerical {
+                    stage: "symbolic Cholesky",
+                    detail: format!("{e:?}"),
+                })?;
         Ok(Self { chol })
+    }
+
+    /// The elimination order (`order[k]` = the free DOF eliminated k-th).
+    pub(crate) fn order(&self) -> Option<Vec<usize>> {
+        self.chol.perm().map(|p| p.arrays().0.to_vec())
     }
 
     /// Number of stored entries of the factor L.

@@ -239,6 +239,43 @@ impl BucklingSolver {
         model: &ShellModel,
         element: Box<dyn ShellElement>,
     ) -> Result<Self, FeError> {
+        Self::build(model, element, None)
+    }
+
+    /// As [`BucklingSolver::new`], eliminating the nodes in the order of `node_rank` (one rank
+    /// per node of `model`, lowest first; a node's free DOFs together) instead of computing an
+    /// AMD ordering: for a mesh nested in one already ordered (the print states of a cap, each
+    /// the next one's mesh less its top row), the larger mesh's order restricted to this one
+    /// ([`BucklingSolver::node_order`]). The factors are the same up to round-off (another
+    /// elimination order); the fill may differ (docs/convergence.md, the `speed5` branch).
+    pub fn with_node_order(model: &ShellModel, node_rank: &[usize]) -> Result<Self, FeError> {
+        let mut s = Self::build(model, model.element.implementation(), Some(node_rank))?;
+        s.kind = Some(model.element);
+        Ok(s)
+    }
+
+    /// Every node's place in this solver's elimination order (its first free DOF's), for
+    /// [`BucklingSolver::with_node_order`] on a nested mesh; `usize::MAX` for a node without
+    /// free DOFs.
+    pub fn node_order(&self) -> Vec<usize> {
+        let mut rank = vec![usize::MAX; self.fixed.len()];
+        let order = self
+            .symbolic
+            .order()
+            .unwrap_or_else(|| (0..self.dofs.n_free()).collect());
+        for (k, &i) in order.iter().enumerate() {
+            if let Some(r) = self.dofs.free.get(i).and_then(|g| rank.get_mut(g / 6)) {
+                *r = (*r).min(k);
+            }
+        }
+        rank
+    }
+
+    fn build(
+        model: &ShellModel,
+        element: Box<dyn ShellElement>,
+        node_rank: Option<&[usize]>,
+    ) -> Result<Self, FeError> {
         model.validate()?;
         let t0 = Instant::now();
         let dofs = DofMap::new(model);
@@ -246,7 +283,29 @@ impl BucklingSolver {
             return Err(FeError::NoFreeDofs);
         }
         let pattern = Pattern::new(model, &dofs);
-        let symbolic = Symbolic::new(&pattern)?;
+        let order = match node_rank {
+            None => None,
+            Some(rank) => {
+                if rank.len() != model.nodes.len() {
+                    return Err(FeError::PatternMismatch {
+                        reason: "a node order must rank every node of the model",
+                    });
+                }
+                // Free DOFs by their node's rank, a node's DOFs together (a stable sort keeps
+                // them in DOF order); the ranks need not be distinct or dense.
+                let mut fwd: Vec<usize> = (0..dofs.n_free()).collect();
+                fwd.sort_by_key(|&k| rank[dofs.free[k] / 6]);
+                let mut inv = vec![0; fwd.len()];
+                for (k, &i) in fwd.iter().enumerate() {
+                    inv[i] = k;
+                }
+                Some((fwd, inv))
+            }
+        };
+        let symbolic = Symbolic::ordered(
+            &pattern,
+            order.as_ref().map(|(f, i)| (f.as_slice(), i.as_slice())),
+        )?;
         Ok(Self {
             triangles: model.triangles.clone(),
             fixed: model.fixed_mask(),
@@ -1213,6 +1272,52 @@ mod tests {
         let mut m = ShellModel::new(nodes, tris, 0.01, mat);
         m.supports = (0..3).map(Support::clamped).collect();
         m
+    }
+
+    /// A given node order is another elimination order of the same matrix: the same factor up
+    /// to round-off, whatever the order's quality. The barrel vault's nodes in reverse, and a
+    /// larger vault's AMD order restricted to a nested one (the print states' use), against each
+    /// model's own AMD.
+    #[test]
+    fn a_given_node_order_gives_the_same_factor() {
+        let opts = BucklingOptions {
+            modes: 1,
+            tolerance: 1e-8,
+            sturm_check: false,
+            ..Default::default()
+        };
+        let small = crate::generate::barrel_vault(12, 6);
+        let amd = BucklingSolver::new(&small).unwrap();
+        let reference = amd.buckling(&small, &opts).unwrap().factors[0];
+        let reverse: Vec<usize> = (0..small.nodes.len()).rev().collect();
+        // The larger vault (n_len 12) has the small one's nodes first (row-major in y), so its
+        // order restricted to them is an order of the small vault.
+        let large = crate::generate::barrel_vault(12, 12);
+        let restricted: Vec<usize> =
+            BucklingSolver::new(&large).unwrap().node_order()[..small.nodes.len()].to_vec();
+        for rank in [&reverse, &restricted] {
+            let s = BucklingSolver::with_node_order(&small, rank).unwrap();
+            assert_eq!(s.n_free_dofs(), amd.n_free_dofs());
+            // The order was used: nodes with free DOFs are eliminated in the given rank order.
+            let used = s.node_order();
+            let mut free: Vec<usize> = (0..small.nodes.len())
+                .filter(|&n| used[n] != usize::MAX)
+                .collect();
+            free.sort_by_key(|&n| rank[n]);
+            assert!(free.windows(2).all(|w| used[w[0]] < used[w[1]]));
+            let f = s.buckling(&small, &opts).unwrap().factors[0];
+            // Both Ritz values meet the residual bound 1e-8 on the same matrix; the eigenvalue
+            // error is of the order of its square, so 1e-9 relative bounds the difference.
+            assert!(
+                (f - reference).abs() <= 1e-9 * reference,
+                "{f} vs {reference}"
+            );
+        }
+        // A node order must rank every node.
+        assert!(matches!(
+            BucklingSolver::with_node_order(&small, &reverse[1..]),
+            Err(FeError::PatternMismatch { .. })
+        ));
     }
 
     /// A warm start from the converged mode ends in fewer Lanczos steps at the same factor (the

@@ -195,3 +195,87 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
     };
     (reduced, map)
 }
+
+/// The state's network on a coarser mesh (issue 25, the coarse-mesh screen of
+/// docs/convergence.md): every `row_stride`-th layer row (anchored at print index 0, the first
+/// and the top row always, as [`crate::analysis::shell::state_shell`]'s `row_stride`) and every
+/// `node_stride`-th node along each kept row (both feet kept, [`thinned`]'s nearly equal steps).
+/// Strides 1 and 1 give the state's shell nodes (column ends are dropped: the shell does not
+/// use them); 2 and 2 the mesh 2h.
+pub fn coarsened_state(state: &State, row_stride: usize, node_stride: usize) -> State {
+    let (rs, ns) = (row_stride.max(1), node_stride.max(1));
+    let net = &state.network;
+    let rows = crate::analysis::shell::layer_rows(net);
+    let top = rows.len().saturating_sub(1);
+    let mut map: Vec<usize> = rows
+        .iter()
+        .enumerate()
+        .filter(|(q, _)| q % rs == 0 || *q == top)
+        .flat_map(|(_, (_, row))| {
+            thinned(row.len(), ns)
+                .into_iter()
+                .filter_map(|j| row.get(j).copied())
+        })
+        .collect();
+    map.sort_unstable();
+    State {
+        index: state.index,
+        layers_printed: state.layers_printed,
+        top_layer: state.top_layer,
+        progress: state.progress,
+        factors: state.factors.clone(),
+        column_force_per_weight: state.column_force_per_weight.clone(),
+        network: crate::form::states::Network {
+            nodes: map
+                .iter()
+                .filter_map(|&i| net.nodes.get(i).cloned())
+                .collect(),
+            trails: Vec::new(),
+            deviation_edges: Vec::new(),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 2h network of a default-cap state: the rows at even print index and the top row,
+    /// each with both feet and every other node between them (⌈(len − 1)/2⌉ steps), in the
+    /// network's own top-down order; strides 1 keep every shell node.
+    #[test]
+    fn coarsened_state_keeps_every_other_row_and_node_and_the_feet() {
+        let cap = crate::design_cap(&crate::Design::default(), crate::Context::default())
+            .expect("the default design is valid");
+        let state = cap.state(21).expect("state 21 exists");
+        let rows = crate::analysis::shell::layer_rows(&state.network);
+        let shell_nodes: Vec<_> = state
+            .network
+            .nodes
+            .iter()
+            .filter(|n| n.role != crate::form::states::Role::ColumnEnd)
+            .cloned()
+            .collect();
+        assert_eq!(coarsened_state(&state, 1, 1).network.nodes, shell_nodes);
+        let coarse = coarsened_state(&state, 2, 2);
+        let coarse_rows = crate::analysis::shell::layer_rows(&coarse.network);
+        let kept: Vec<&(i32, Vec<usize>)> = rows
+            .iter()
+            .enumerate()
+            .filter(|(q, _)| q % 2 == 0 || *q == rows.len() - 1)
+            .map(|(_, r)| r)
+            .collect();
+        assert_eq!(coarse_rows.len(), kept.len());
+        for ((id, full), (cid, thin)) in kept.iter().map(|r| (&r.0, &r.1)).zip(&coarse_rows) {
+            assert_eq!(id, cid);
+            assert_eq!(thin.len(), (full.len() - 1).div_ceil(2) + 1, "layer {id}");
+            let (Some(&f0), Some(&f1), Some(&c0), Some(&c1)) =
+                (full.first(), full.last(), thin.first(), thin.last())
+            else {
+                panic!("empty row {id}");
+            };
+            assert_eq!(coarse.network.nodes[c0].xyz, state.network.nodes[f0].xyz);
+            assert_eq!(coarse.network.nodes[c1].xyz, state.network.nodes[f1].xyz);
+        }
+    }
+}

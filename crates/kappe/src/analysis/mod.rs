@@ -66,11 +66,11 @@ pub use collapse::{
     CURVE_POINTS, CollapseMode, CollapseOptions, StateLba, cap_as_printed_shift,
     cap_state_collapse, cap_state_lba, collapse_factor, object_as_printed_shift, shifted,
 };
-pub use graded::{Grading, graded_rows, graded_state};
+pub use graded::{Grading, coarsened_state, graded_rows, graded_state};
 pub use green::{
     CapGreen, ElementLayers, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli,
 };
 pub use reliability::{
     Check, GreenField, Vars, check_form, limit_state, prepare, reliability, scaled_ages, state_form,
 };
-pub use shell::state_shell;
+pub use shell::{StateShell, state_shell};
