@@ -1,11 +1,13 @@
 //! The collapse check of the default cap (docs/collapse.md §5–6): per state run, the collapse
 //! factor next to its BLF, the time of its path against its own linear buckling solve (wall and
-//! CPU), and the analysis time with and without the check:
+//! CPU) and against a fixed reference solve of the same model (1e-8 with a Sturm count: the
+//! check's own LBA until session 8, `ref`), and the analysis time with and without the check:
 //! `cargo run --release -p kappe --example collapse_cap [-- STATES [SIGNS [as_printed]]]`
 //! (STATES: how many of the least-BLF states, default 3; SIGNS: force 1 or 2 imperfection
 //! signs, 0 = the rule; `as_printed`: also each state's path from the as-printed shape,
 //! docs/collapse.md §8). STATES = 0 skips the table; the analysis with the check runs last
-//! unless `NO_FULL` is the fourth argument.
+//! unless `NO_FULL` is the fourth argument. `state=N` (repeatable) runs the table for those
+//! states alone, without either analysis.
 
 use std::time::Instant;
 
@@ -37,27 +39,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }),
         ..Default::default()
     };
-    let (t0, c0) = (Instant::now(), cpu());
-    let a = analyze(&cap, &off, kappe::analysis::Request::default())?;
-    let (t_off, c_off) = (t0.elapsed().as_secs_f64(), cpu() - c0);
-    let mut by_bound: Vec<(usize, f64)> = a
-        .states
+    let words: Vec<String> = std::env::args().collect();
+    // `state=N`: that state alone, without the analyses (its BLF column is then NaN).
+    let only: Vec<usize> = words
         .iter()
-        .filter_map(|s| s.blf.map(|b| (s.index, b)))
+        .filter_map(|w| w.strip_prefix("state=")?.parse().ok())
         .collect();
-    by_bound.sort_by(|x, y| x.1.total_cmp(&y.1));
-    println!(
-        "analysis without the collapse check: {t_off:.2} s wall, {c_off:.2} s CPU (load {})",
-        load_average()
-    );
+    let (mut t_off, mut c_off) = (f64::NAN, f64::NAN);
+    let mut by_bound: Vec<(usize, f64)> = only.iter().map(|&q| (q, f64::NAN)).collect();
+    if only.is_empty() {
+        let (t0, c0) = (Instant::now(), cpu());
+        let a = analyze(&cap, &off, kappe::analysis::Request::default())?;
+        (t_off, c_off) = (t0.elapsed().as_secs_f64(), cpu() - c0);
+        by_bound = a
+            .states
+            .iter()
+            .filter_map(|s| s.blf.map(|b| (s.index, b)))
+            .collect();
+        by_bound.sort_by(|x, y| x.1.total_cmp(&y.1));
+        println!(
+            "analysis without the collapse check: {t_off:.2} s wall, {c_off:.2} s CPU (load {})",
+            load_average()
+        );
+    }
     let spec = NonlinearSpec {
         signs: arg(2).filter(|s| *s > 0),
         ..Default::default()
     };
-    let words: Vec<String> = std::env::args().collect();
     let as_printed = words.iter().any(|w| w == "as_printed");
     println!(
-        "  {:>5} {:>8} {:>9} {:>12} {:>5} {:>5} {:>5} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7}",
+        "  {:>5} {:>8} {:>9} {:>12} {:>5} {:>5} {:>5} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7} {:>8} {:>7}",
         "state",
         "BLF",
         "collapse",
@@ -70,32 +81,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "path wall",
         "path CPU",
         "wall ×",
-        "CPU ×"
+        "CPU ×",
+        "ref CPU",
+        "ref ×"
     );
     let options = AnalysisOptions::default();
     for &(q, b) in by_bound.iter().take(arg(1).unwrap_or(3)) {
         // The state's linear buckling solve alone (the collapse check's first half), best of
         // two so a cold cache does not count against the LBA.
         let (mut tl, mut cl) = (f64::INFINITY, f64::INFINITY);
+        // The reference solve of the same model, fixed across sessions: 1e-8 with a Sturm
+        // count (the collapse check's own LBA until session 8).
+        let (mut tr, mut cr) = (f64::INFINITY, f64::INFINITY);
         for _ in 0..2 {
             let (t, c) = (Instant::now(), cpu());
-            let _ = cap_state_lba(&cap, &options, None, q)?;
+            let lba = cap_state_lba(&cap, &options, None, q)?;
             tl = tl.min(t.elapsed().as_secs_f64());
             cl = cl.min(cpu() - c);
+            if let Some(l) = lba {
+                let (t, c) = (Instant::now(), cpu());
+                let _ = kappe_fe::buckling(
+                    &l.shell.model,
+                    &kappe_fe::BucklingOptions {
+                        modes: 1,
+                        tolerance: 1e-8,
+                        sturm_check: true,
+                        ..Default::default()
+                    },
+                )?;
+                tr = tr.min(t.elapsed().as_secs_f64());
+                cr = cr.min(cpu() - c);
+            }
         }
         let (t, c0) = (Instant::now(), cpu());
         let c = cap_state_collapse(&cap, &options, &spec, None, q, f64::INFINITY)?;
         let (tp, cp) = (t.elapsed().as_secs_f64(), cpu() - c0);
         if let Some(c) = c {
             println!(
-                "  {q:>5} {b:>8.4} {:>9.4} {:>12} {:>5} {:>5} {:>5} {tl:>9.2} {cl:>9.2} {tp:>9.2} {cp:>9.2} {:>7.1} {:>7.1}",
+                "  {q:>5} {b:>8.4} {:>9.4} {:>12} {:>5} {:>5} {:>5} {tl:>9.2} {cl:>9.2} {tp:>9.2} {cp:>9.2} {:>7.1} {:>7.1} {cr:>8.2} {:>7.1}",
                 c.factor,
                 c.mode.name(),
                 c.steps,
                 c.assemblies,
                 c.factorizations,
                 tp / tl,
-                cp / cl
+                cp / cl,
+                cp / cr
             );
         }
         if as_printed {
@@ -117,7 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
         }
     }
-    if words.iter().any(|w| w == "NO_FULL") {
+    if words.iter().any(|w| w == "NO_FULL") || !only.is_empty() {
         return Ok(());
     }
     let (t1, c1) = (Instant::now(), cpu());

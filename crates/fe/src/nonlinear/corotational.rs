@@ -314,12 +314,28 @@ impl LocalGeometric {
         for kk in 0..3 {
             let ck = self.c.row(kk).transpose();
             f += gd[kk] * nt[kk] + ck * (0.5 * q[kk]);
-            k += gd[kk] * ck.transpose() + ck * gd[kk].transpose();
+            // Σ_j 2 (D_m/2A)_kj G_k d̄ d̄ᵀ G_j = G_k d̄ hᵀ with h = Σ_j 2 (D_m/2A)_kj G_j d̄:
+            // two rank-one updates per k instead of four.
+            let mut h = ck;
             for j in 0..3 {
-                k += gd[kk] * gd[j].transpose() * (2.0 * self.dq[(kk, j)]);
+                h += gd[j] * (2.0 * self.dq[(kk, j)]);
             }
+            k += gd[kk] * h.transpose() + ck * gd[kk].transpose();
         }
         (f, k)
+    }
+
+    /// The force of [`Self::force_tangent`] alone (a residual check needs no tangent).
+    fn force(&self, d: &Vec18) -> Vec18 {
+        let n = self.c * d;
+        let gd = self.g_times(d);
+        let q = Vector3::new(d.dot(&gd[0]), d.dot(&gd[1]), d.dot(&gd[2]));
+        let nt = n + self.dq * q;
+        let mut f = Vec18::zeros();
+        for kk in 0..3 {
+            f += gd[kk] * nt[kk] + self.c.row(kk).transpose() * (0.5 * q[kk]);
+        }
+        f
     }
 }
 
@@ -464,10 +480,12 @@ impl CrElement {
         let k = self.kinematics(x, r);
         let (fbar, ktan) = match (stress_of, &self.local) {
             (None, None) => (self.kbar * k.d, self.kbar),
-            (None, Some(l)) => {
+            (None, Some(l)) if tangent => {
                 let (fg, kg) = l.force_tangent(&k.d);
                 (self.kbar * k.d + fg, self.kbar + kg)
             }
+            // A force evaluation: the tangent is never used (`ktan` below).
+            (None, Some(l)) => (self.kbar * k.d + l.force(&k.d), self.kbar),
             (Some(d), local) => {
                 let kg = local.as_ref().map_or_else(Mat18::zeros, |l| {
                     let n = l.c * d;

@@ -115,6 +115,9 @@ impl State {
 /// moment is not conservative for three-dimensional rotations; Argyris 1982).
 pub(crate) struct Tangent {
     pub(crate) sym: Vec<f64>,
+    /// Empty without applied moments: the skew part then vanishes at equilibrium, where
+    /// the predictors use the tangent, and Newton's corrections use `K_s` alone anyway
+    /// (path.rs), so it is neither built nor scattered.
     pub(crate) skew: Vec<f64>,
 }
 
@@ -122,6 +125,9 @@ impl Tangent {
     /// `y = (K_s + K_k) x`.
     pub(crate) fn matvec(&self, p: &Pattern, x: &[f64], y: &mut [f64]) {
         p.sym_matvec(&self.sym, x, y);
+        if self.skew.is_empty() {
+            return;
+        }
         for j in 0..p.n {
             for k in p.col_ptr[j]..p.col_ptr[j + 1] {
                 let i = p.row_idx[k];
@@ -246,25 +252,28 @@ impl<'m> Problem<'m> {
         let mut fg = vec![0.0; 6 * model.nodes.len()];
         let mut kv = tangent.then(|| Tangent {
             sym: vec![0.0; self.pattern.nnz()],
-            skew: vec![0.0; self.pattern.nnz()],
+            skew: if self.has_moments {
+                vec![0.0; self.pattern.nnz()]
+            } else {
+                Vec::new()
+            },
         });
+        let skew = self.has_moments;
         const CHUNK: usize = 2048;
         let n_el = model.triangles.len();
         let mut start = 0;
         while start < n_el {
             let end = (start + CHUNK).min(n_el);
-            type Pair = (crate::element::Mat18, crate::element::Mat18);
-            let out: Vec<(Vec18, Option<Pair>)> = (start..end)
+            // Each element's tangent is collected as it is and split into its symmetric and
+            // skew parts while scattering: one 18×18 matrix per element through the collect
+            // instead of two halves the memory it moves.
+            let out: Vec<(Vec18, Option<crate::element::Mat18>)> = (start..end)
                 .into_par_iter()
                 .map(|e| {
                     let t = &model.triangles[e];
                     let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
                     let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
-                    let (f, k) = self.elements[e].force_tangent(&x, &r, tangent);
-                    (
-                        f,
-                        k.map(|k| ((k + k.transpose()) * 0.5, (k - k.transpose()) * 0.5)),
-                    )
+                    self.elements[e].force_tangent(&x, &r, tangent)
                 })
                 .collect();
             for (e, (f, k)) in (start..end).zip(out) {
@@ -274,9 +283,26 @@ impl<'m> Problem<'m> {
                         fg[6 * n + d] += f[6 * a + d];
                     }
                 }
-                if let (Some((ks, kk)), Some(tg)) = (k, kv.as_mut()) {
-                    scatter(model, &self.dofs, &self.pattern, e, &ks, &mut tg.sym)?;
-                    scatter(model, &self.dofs, &self.pattern, e, &kk, &mut tg.skew)?;
+                if let (Some(k), Some(tg)) = (k, kv.as_mut()) {
+                    let kt = k.transpose();
+                    scatter(
+                        model,
+                        &self.dofs,
+                        &self.pattern,
+                        e,
+                        &((k + kt) * 0.5),
+                        &mut tg.sym,
+                    )?;
+                    if skew {
+                        scatter(
+                            model,
+                            &self.dofs,
+                            &self.pattern,
+                            e,
+                            &((k - kt) * 0.5),
+                            &mut tg.skew,
+                        )?;
+                    }
                 }
             }
             start = end;

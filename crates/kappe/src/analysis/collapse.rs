@@ -478,6 +478,9 @@ pub struct StateLba {
     pub shell: crate::analysis::shell::StateShell,
     /// The LBA: factor and lowest mode; `None` when the state is a mechanism.
     pub lba: Option<(f64, Vec<[f64; 6]>)>,
+    /// The LBA's own linear static solution of the same model under its weight (its
+    /// prebuckling state); `None` with `lba`.
+    pub linear: Option<kappe_fe::StaticResult>,
 }
 
 /// The model of cap state `top` and its linear buckling solve (the first half of
@@ -498,8 +501,13 @@ pub fn cap_state_lba(
         &shell.model,
         &kappe_fe::BucklingOptions {
             modes: 1,
-            // As the LBA check (buckling.rs): far below any modelling error.
+            // Far below any modelling error; a mode this converged is the imperfection's
+            // shape to ~1e-8 of w0.
             tolerance: 1e-8,
+            // As the LBA check (buckling.rs): the Sturm count that no lower factor was
+            // missed only when the analysis asks for it. It costs one more LDLᵀ, about 40 %
+            // of this solve (docs/collapse.md §6).
+            sturm_check: options.sturm_check,
             ..Default::default()
         },
     ) {
@@ -509,6 +517,7 @@ pub fn cap_state_lba(
                 state,
                 shell,
                 lba: None,
+                linear: None,
             }));
         }
         Err(e) => {
@@ -518,6 +527,7 @@ pub fn cap_state_lba(
             });
         }
     };
+    let linear = Some(lba.static_result);
     let lba = lba
         .factors
         .first()
@@ -526,7 +536,12 @@ pub fn cap_state_lba(
     if lba.is_none() {
         return Ok(None);
     }
-    Ok(Some(StateLba { state, shell, lba }))
+    Ok(Some(StateLba {
+        state,
+        shell,
+        lba,
+        linear,
+    }))
 }
 
 /// The collapse of one cap state (top print index `top`) on its full shell mesh: its LBA
@@ -541,7 +556,13 @@ pub fn cap_state_collapse(
     top: usize,
     above: f64,
 ) -> Result<Option<Collapse>, DesignError> {
-    let Some(StateLba { state, shell, lba }) = cap_state_lba(cap, options, green, top)? else {
+    let Some(StateLba {
+        state,
+        shell,
+        lba,
+        linear,
+    }) = cap_state_lba(cap, options, green, top)?
+    else {
         return Ok(None);
     };
     let model = &shell.model;
@@ -568,12 +589,14 @@ pub fn cap_state_collapse(
         });
     let w0 = spec.amplitude(model.thickness_of(0), (zmax - zmin).max(0.0));
     let start;
-    let model = match spec.start {
-        crate::input::nonlinear::PathStart::Design => model,
+    // From the design, the path's model is the LBA's, and so is its linear static solution
+    // (one factorization of K fewer per state).
+    let (model, linear) = match spec.start {
+        crate::input::nonlinear::PathStart::Design => (model, linear),
         crate::input::nonlinear::PathStart::AsPrinted => {
             let shift = cap_as_printed_shift(cap, options, green, top, &state, &shell)?;
             start = shifted(model, &shift);
-            &start
+            (&start, None)
         }
     };
     let (elements, ages, time) = match green {
@@ -589,7 +612,7 @@ pub fn cap_state_collapse(
             g.time
                 .strength
                 .is_some()
-                .then(|| kappe_fe::linear_static(model).ok())
+                .then(|| linear.or_else(|| kappe_fe::linear_static(model).ok()))
                 .flatten()
                 .map(|st| {
                     crate::analysis::green::stress_checks(
@@ -685,6 +708,13 @@ pub fn as_printed_shift(
         .collect()
 }
 
+/// The as-printed increments of a buildability object's layer counts, kept across the
+/// object's layer counts within one run: increment k (the weight of the k-layer object's top
+/// strip on that object, with the moduli at its ages) is the same for every n ≥ k, so a run
+/// over n = 1…N solves N increments instead of N(N+1)/2.
+#[derive(Debug, Default)]
+pub struct ObjectIncrements(std::sync::Mutex<std::collections::HashMap<usize, Vec<[f64; 6]>>>);
+
 /// The deviation an `n`-layer buildability object's print locks into its geometry, as
 /// [`cap_as_printed_shift`]: `shell(k)` is the k-layer object (its nodes numbered row by row
 /// from the bed, the same in every k), `ages(k)` its layers' ages, `own` the n-layer model
@@ -701,11 +731,31 @@ pub fn object_as_printed_shift(
     time: &TimeModel,
     own: &ShellModel,
 ) -> Result<Vec<[f64; 3]>, DesignError> {
+    object_as_printed_shift_cached(n, shell, ages, time, own, &ObjectIncrements::default())
+}
+
+/// [`object_as_printed_shift`] with the increments taken from, and added to, `cache` (which
+/// must belong to the same object, schedule and time model).
+///
+/// # Errors
+/// A static solve fails.
+pub fn object_as_printed_shift_cached(
+    n: usize,
+    shell: &(dyn Fn(usize) -> (ShellModel, Vec<ElementLayers>) + Sync),
+    ages: &(dyn Fn(usize) -> Vec<f64> + Sync),
+    time: &TimeModel,
+    own: &ShellModel,
+    cache: &ObjectIncrements,
+) -> Result<Vec<[f64; 3]>, DesignError> {
     use rayon::prelude::*;
     let fe = |e: kappe_fe::FeError| DesignError::FormFinding(format!("as-printed start: {e}"));
+    let known = |k: usize| cache.0.lock().ok().and_then(|m| m.get(&k).cloned());
     let increments = (1..=n)
         .into_par_iter()
         .map(|k| {
+            if let Some(du) = known(k) {
+                return Ok(du);
+            }
             let (mut m, layers) = shell(k);
             crate::analysis::green::set_aged_moduli(&mut m, &layers, &ages(k), time);
             m.materials = (0..m.triangles.len())
@@ -717,9 +767,13 @@ pub fn object_as_printed_shift(
                     mat
                 })
                 .collect();
-            kappe_fe::linear_static(&m)
+            let du = kappe_fe::linear_static(&m)
                 .map(|r| r.displacements)
-                .map_err(fe)
+                .map_err(fe)?;
+            if let Ok(mut c) = cache.0.lock() {
+                c.insert(k, du.clone());
+            }
+            Ok(du)
         })
         .collect::<Result<Vec<_>, DesignError>>()?;
     let mut printed = vec![[0.0; 3]; own.nodes.len()];

@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 use kappe_fe::{Material, ShellModel, Support};
 
 use crate::analysis::collapse::{
-    Collapse, CollapseMode, CollapseOptions, collapse_factor, object_as_printed_shift, shifted,
+    Collapse, CollapseMode, CollapseOptions, ObjectIncrements, collapse_factor,
+    object_as_printed_shift_cached, shifted,
 };
 use crate::analysis::green::{
     BucklingOutcome, ElementLayers, FailureMode, GreenOptions, ModeStart, WorstElement, check_state,
@@ -567,6 +568,17 @@ pub fn check_layers_warm(
     n: usize,
     prev: Option<&[[f64; 6]]>,
 ) -> Result<(BuildState, Option<ModeStart>), DesignError> {
+    check_layers_cached(r, n, prev, &ObjectIncrements::default())
+}
+
+/// [`check_layers_warm`] with the as-printed increments of the layer counts kept in `cache`
+/// across calls on the same `r` (docs/as-printed.md; used only with `start = "as_printed"`).
+pub fn check_layers_cached(
+    r: &Resolved,
+    n: usize,
+    prev: Option<&[[f64; 6]]>,
+    cache: &ObjectIncrements,
+) -> Result<(BuildState, Option<ModeStart>), DesignError> {
     let (mut model, layers) = object_shell(r, n);
     let cols = model.nodes.len() / (n + 1);
     let start = prev.and_then(|p| extend_mode(p, model.nodes.len(), cols));
@@ -595,12 +607,13 @@ pub fn check_layers_warm(
                 PathStart::Design => None,
                 PathStart::AsPrinted => Some(shifted(
                     &model,
-                    &object_as_printed_shift(
+                    &object_as_printed_shift_cached(
                         n,
                         &|k| object_shell(r, k),
                         &|k| r.schedule.ages(k),
                         &r.time,
                         &model,
+                        cache,
                     )?,
                 )),
             };
@@ -696,6 +709,7 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
     // Without stop_at_failure one round covers every layer count.
     let rounds_per_batch = if stop { 2 } else { max.div_ceil(chains) };
     let mut next = 1;
+    let increments = ObjectIncrements::default();
     while next <= max {
         let hi = (next + chains * rounds_per_batch - 1).min(max);
         let results: Vec<Result<ChainPart, DesignError>> = modes
@@ -706,7 +720,7 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
                 let mut out = Vec::new();
                 let mut n = next + i;
                 while n <= hi {
-                    let (s, mode) = check_layers_warm(r, n, prev.as_deref())?;
+                    let (s, mode) = check_layers_cached(r, n, prev.as_deref(), &increments)?;
                     on_state(n);
                     out.push(s);
                     if mode.is_some() {
