@@ -928,7 +928,7 @@ pub enum Prebuilt<'a> {
     /// Run FORM; the limit state already holds the solve at the means.
     Solve(Box<TimeBuckling<'a>>),
     /// Screened: the first-order result stands for FORM's.
-    Screened(FormResult),
+    Screened(Box<FormResult>),
 }
 
 /// [`state_form`] with the state's buckling component prepared by [`first_order`].
@@ -987,7 +987,7 @@ fn state_form_with<'a>(
         if let (Check::BucklingTime { .. }, Some(p)) = (check, prebuilt.take()) {
             match p {
                 Prebuilt::Solve(g) => named.push((check.name(), g)),
-                Prebuilt::Screened(r) => given.push((check.name(), r)),
+                Prebuilt::Screened(r) => given.push((check.name(), *r)),
             }
             continue;
         }
@@ -1160,7 +1160,7 @@ fn prebuild<'a>(
 ) -> Option<Prebuilt<'a>> {
     f.map(|(g, r)| {
         if screen {
-            Prebuilt::Screened(r)
+            Prebuilt::Screened(Box::new(r))
         } else {
             Prebuilt::Solve(g)
         }
@@ -1195,7 +1195,7 @@ pub fn first_order_against_form(
         .zip(per_state.par_iter())
         .filter_map(|(f, (index, t_hours, _))| f.map(|f| (f, *index, *t_hours)))
         .map(|((mut g, first), index, t_hours)| {
-            let state_model = model.drifted(&drifts, t_hours).map_err(|e| rel_err(e))?;
+            let state_model = model.drifted(&drifts, t_hours).map_err(rel_err)?;
             match form(&state_model, g.as_mut(), &FormOptions::default()) {
                 Ok(r) => Ok(Some((index, first.beta, r.beta))),
                 // As in the run: a component FORM cannot converge beyond FAR_BETA is left out.
