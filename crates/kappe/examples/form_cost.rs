@@ -79,22 +79,57 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or(2);
     println!(
         "row | det. analysis wall s | nominal run CPU s | reliability wall s | CPU s | \
-         ratio wall | ratio CPU | components | print β | load"
+         ratio wall | ratio CPU | components | screened states | print β | print P_f | load"
     );
     // `form_cost [repeats] [rows]`: rows a list of 1 (study No. 14, time parameters), 2 (+
     // strength, speed), 3 (the default cap, time parameters); default all.
     let rows = std::env::args().nth(2).unwrap_or_else(|| "123".into());
+    // a, b, c: rows 1, 2, 3 with the screening off (`[uncertainty] screening = false`).
     let all = [
         ("study 14, time parameters", '1'),
         ("study 14, + strength, speed", '2'),
         ("default cap, time parameters", '3'),
+        ("study 14, time parameters, unscreened", 'a'),
+        ("study 14, + strength, speed, unscreened", 'b'),
+        ("default cap, time parameters, unscreened", 'c'),
     ];
+    // `form_cost 0 13 delta`: per state, the buckling component's first-order β₁ against FORM's
+    // β (screening off), and the largest |β − β₁| (the screening rule's δ).
+    let delta = std::env::args().nth(3).is_some_and(|a| a == "delta");
     for (name, row) in all.into_iter().filter(|(_, r)| rows.contains(*r)) {
-        let d = match row {
-            '1' => cap(false)?,
-            '2' => cap(true)?,
+        let mut d = match row {
+            '1' | 'a' => cap(false)?,
+            '2' | 'b' => cap(true)?,
             _ => default_cap()?,
         };
+        if row.is_ascii_lowercase()
+            && let Some(u) = d.uncertainty.as_mut()
+        {
+            u.screening = Some(false);
+        }
+        if delta {
+            let mut nominal = d.clone();
+            nominal.uncertainty = None;
+            let out = run(&nominal, &Options::of(&nominal), &no_progress)?;
+            let analysis = out.analysis.as_ref().ok_or("no analysis")?;
+            let cap = design_cap(&d, kappe::Context::default())?;
+            let pairs = kappe::analysis::first_order_against_form(&cap, analysis, &out.schedule)?;
+            println!("{name}: state | beta_1 | beta_FORM | beta_FORM - beta_1");
+            let mut worst = (0.0_f64, 0);
+            for (i, b1, b) in &pairs {
+                println!("  {i} | {b1:.4} | {b:.4} | {:+.4}", b - b1);
+                if (b - b1).abs() > worst.0 {
+                    worst = ((b - b1).abs(), *i);
+                }
+            }
+            println!(
+                "{name}: {} states, largest |beta_FORM - beta_1| = {:.4} (state {})",
+                pairs.len(),
+                worst.0,
+                worst.1
+            );
+            continue;
+        }
         let mut nominal = d.clone();
         nominal.uncertainty = None;
         let cap = design_cap(&d, kappe::Context::default())?;
@@ -121,11 +156,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             median(&mut rc),
         );
         println!(
-            "{name} | {dw:.2} | {dc:.2} | {rw:.2} | {rc:.2} | {:.2} | {:.2} | {} | {:.2} | {}",
+            "{name} | {dw:.2} | {dc:.2} | {rw:.2} | {rc:.2} | {:.2} | {:.2} | {} | {} of {} | {:.4} | \
+             {:.4e} | {}",
             rw / dw,
             rc / dc,
             r.components,
+            r.states.iter().filter(|s| s.beta_first_order).count(),
+            r.states.len(),
             r.beta,
+            r.pf,
             load_average()
         );
     }

@@ -24,6 +24,21 @@
 //! Drift: the state printed at t (h, the end of its top layer on the run's schedule) uses the
 //! variables scaled by each drift's factor c(t) ([`kappe_reliability::Model::drifted`]); all states
 //! share one u-space, which the series system needs.
+//!
+//! # Screening
+//!
+//! A buckling component with the time model uncertain ([`TimeBuckling`]) costs a re-solve of the
+//! state's shell per FORM iterate. Every such state first gets the one solve FORM starts with, at
+//! the drifted means, and from it ([`first_order`]) the first-order β₁ of G = ln(BLF/BLF_min)
+//! (exact for a product of powers of lognormals, which λ nearly is). The state with the least
+//! β₁ is solved by FORM; the largest component P_f it gives, P_b, bounds the print's P_f from
+//! below (a series system fails at least as often as its weakest component). A state whose
+//! N·Φ(−(β₁ − δ)) < [`SCREEN_SHARE`]·P_b (N the states with such a component) keeps its
+//! first-order result as its buckling component, flagged `beta_first_order`: with
+//! |β_FORM − β₁| ≤ δ, each such state's P_f is below SCREEN_SHARE·P_b/N, so all of them together
+//! hold less than SCREEN_SHARE of the print's P_f, and none can govern. δ = [`SCREEN_DELTA`], the
+//! largest |β_FORM − β₁| measured over every state of two caps times a safety factor. The other
+//! states run FORM from the cached solve. `[uncertainty] screening = false` runs FORM on all.
 
 use std::collections::BTreeMap;
 
@@ -50,6 +65,24 @@ pub const FAR_BETA: f64 = 8.0;
 /// Samples of each state's own series system (its few checks).
 const STATE_SYSTEM_SAMPLES: u64 = 4_000;
 
+/// δ of the screening rule: the allowance on the first-order β₁ of a state's buckling component
+/// (`SCREEN_DELTA_MEASURED` × [`SCREEN_SAFETY`]).
+pub const SCREEN_DELTA: f64 = SCREEN_DELTA_MEASURED * SCREEN_SAFETY;
+
+/// The largest |β_FORM − β₁| measured over every analysed state of the default cap and study
+/// No. 14's cap with the time parameters uncertain (`form_cost -- 0 d`, docs/reliability.md,
+/// "Screening").
+pub const SCREEN_DELTA_MEASURED: f64 = 0.651;
+
+/// Safety factor on the measured δ: the measured caps span E₀ cov 0.15–0.2, Ė cov 0.3; a design
+/// with larger scatter bends ln λ more, and the factor covers that until it is measured.
+pub const SCREEN_SAFETY: f64 = 2.0;
+
+/// A state's buckling component is screened (first order, no FORM) when N·Φ(−(β₁ − δ)) is below
+/// this share of the print's P_f bound (the largest component P_f solved so far): all screened
+/// components together then hold less than this share of the print's P_f.
+pub const SCREEN_SHARE: f64 = 1e-3;
+
 /// The reliability of one state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct StateReliability {
@@ -63,6 +96,11 @@ pub struct StateReliability {
     pub pf: f64,
     /// β per check (`buckling`, `sigma_min`, `sigma_max`, `strength`).
     pub beta_by_check: BTreeMap<String, f64>,
+    /// The state's buckling β is the first-order β₁ of ln(BLF/BLF_min) at the drifted means,
+    /// not FORM's: the screening rule showed that it cannot move the print's P_f by more than
+    /// [`SCREEN_SHARE`] of it (module docs, "Screening"). Absent when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub beta_first_order: bool,
 }
 
 /// One parameter's share in the governing check.
@@ -872,6 +910,39 @@ pub fn state_form(
     t_hours: f64,
     checks: &[Check],
 ) -> Result<Option<StateForm>, DesignError> {
+    state_form_with(
+        cap,
+        options,
+        schedule,
+        (model, drifts, v),
+        index,
+        t_hours,
+        checks,
+        None,
+    )
+}
+
+/// The buckling component of a state with the time model uncertain, prepared by
+/// [`first_order`]: either its limit state (with the mean's solve cached) for FORM, or screened.
+pub enum Prebuilt<'a> {
+    /// Run FORM; the limit state already holds the solve at the means.
+    Solve(Box<TimeBuckling<'a>>),
+    /// Screened: the first-order result stands for FORM's.
+    Screened(Box<FormResult>),
+}
+
+/// [`state_form`] with the state's buckling component prepared by [`first_order`].
+#[allow(clippy::too_many_arguments)]
+fn state_form_with<'a>(
+    cap: &'a Cap,
+    options: &'a super::AnalysisOptions,
+    schedule: &'a crate::schedule::Schedule,
+    (model, drifts, v): (&Model, &[(String, Drift)], Vars),
+    index: usize,
+    t_hours: f64,
+    checks: &[Check],
+    mut prebuilt: Option<Prebuilt<'a>>,
+) -> Result<Option<StateForm>, DesignError> {
     if checks.is_empty() {
         return Ok(None);
     }
@@ -905,10 +976,18 @@ pub fn state_form(
         None => None,
     };
     let mut named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = Vec::new();
+    let mut given = Vec::new();
     for &check in checks {
         if let Check::GreenLayers(_) = check {
             if let Some((field, time)) = &field {
                 named.extend(field.components(v, time));
+            }
+            continue;
+        }
+        if let (Check::BucklingTime { .. }, Some(p)) = (check, prebuilt.take()) {
+            match p {
+                Prebuilt::Solve(g) => named.push((check.name(), g)),
+                Prebuilt::Screened(r) => given.push((check.name(), *r)),
             }
             continue;
         }
@@ -941,12 +1020,193 @@ pub fn state_form(
             },
         ));
     }
-    if named.is_empty() {
+    if named.is_empty() && given.is_empty() {
         return Ok(None);
     }
-    form_checks(&state_model, named, index, t_hours, seed)
+    form_checks_with(&state_model, named, given, index, t_hours, seed)
         .map(Some)
         .map_err(rel_err)
+}
+
+/// The first-order β₁ of a state's buckling component, G = ln(BLF/BLF_min) linearised in u-space
+/// at the drifted means (the point FORM starts from, so FORM's first iterate reuses this solve
+/// through [`TimeBuckling::last`]): β₁ = (G₀ − ∇G·u₀)/‖∇G‖, α₁ = −∇G/‖∇G‖, as a FORM result
+/// whose design point is β₁α₁ (module docs, "Screening").
+///
+/// # Errors
+/// A failed solve, or a factor that is not positive at the means.
+pub fn first_order(
+    model: &Model,
+    g: &mut TimeBuckling<'_>,
+) -> Result<FormResult, kappe_reliability::EvalError> {
+    use kappe_reliability::LimitState;
+    let u0 = model.u_from_x(&model.means());
+    let x0 = model.x_from_u(&u0);
+    let mut grad = vec![0.0; x0.len()];
+    let value = g.value_and_gradient(&x0, &mut grad)?.unwrap_or(f64::NAN);
+    let blf = value + g.blf_min;
+    if !(blf > 0.0 && blf.is_finite() && g.blf_min > 0.0) {
+        return Err(format!(
+            "state {}: buckling factor {blf} at the means (BLF_min {})",
+            g.check.2, g.blf_min
+        )
+        .into());
+    }
+    let big_g = (blf / g.blf_min).ln();
+    let grad_ln: Vec<f64> = grad.iter().map(|d| d / blf).collect();
+    let gu = model.gradient_to_standard(&u0, &grad_ln);
+    let norm = gu.iter().map(|d| d * d).sum::<f64>().sqrt();
+    let (beta, alpha) = if norm > 0.0 && norm.is_finite() {
+        let gu0: f64 = gu.iter().zip(&u0).map(|(a, b)| a * b).sum();
+        (
+            (big_g - gu0) / norm,
+            gu.iter().map(|d| -d / norm).collect::<Vec<_>>(),
+        )
+    } else {
+        // ln λ does not move with the variables: the state is safe or fails for every sample.
+        let b = if big_g > 0.0 {
+            f64::INFINITY
+        } else {
+            f64::NEG_INFINITY
+        };
+        (b, vec![0.0; gu.len()])
+    };
+    let u_star: Vec<f64> = alpha.iter().map(|a| a * beta).collect();
+    let x_star = if beta.is_finite() {
+        model.x_from_u(&u_star)
+    } else {
+        x0.clone()
+    };
+    let n = x0.len();
+    Ok(FormResult {
+        names: model.variables().iter().map(|v| v.name.clone()).collect(),
+        beta,
+        pf: kappe_reliability::stdnormal::cdf(-beta),
+        x_star,
+        u_star,
+        importance: alpha.iter().map(|a| a * a).collect(),
+        gamma: alpha.clone(),
+        alpha,
+        dbeta_dmean: vec![f64::NAN; n],
+        dbeta_dstd: vec![f64::NAN; n],
+        g_at_design_point: f64::NAN,
+        g_residual: f64::NAN,
+        u_residual: f64::NAN,
+        iterations: 0,
+        evaluations: 1,
+        gradient_evaluations: 1,
+    })
+}
+
+/// Per state of `per_state` with a [`Check::BucklingTime`]: its limit state (the solve at the
+/// drifted means done) and its first-order result ([`first_order`]); None for other states.
+#[allow(clippy::type_complexity)]
+fn first_orders<'a>(
+    cap: &'a Cap,
+    options: &'a super::AnalysisOptions,
+    schedule: &'a crate::schedule::Schedule,
+    (model, drifts, v): (&Model, &[(String, Drift)], Vars),
+    per_state: &[(usize, f64, Vec<Check>)],
+) -> Result<Vec<Option<(Box<TimeBuckling<'a>>, FormResult)>>, DesignError> {
+    use rayon::prelude::*;
+    let time = cap.design.time_model()?;
+    let blf_min = cap.design.constraints.blf_min;
+    per_state
+        .par_iter()
+        .map(|(index, t_hours, checks)| {
+            let Some(&Check::BucklingTime {
+                blf,
+                s_nu,
+                top,
+                shell0,
+            }) = checks
+                .iter()
+                .find(|c| matches!(c, Check::BucklingTime { .. }))
+            else {
+                return Ok(None);
+            };
+            let state_model =
+                model
+                    .drifted(drifts, *t_hours)
+                    .map_err(|e| DesignError::Uncertainty {
+                        field: "uncertainty.drift".into(),
+                        message: format!("state {index} at {t_hours:.3} h: {e}"),
+                    })?;
+            let mut g = Box::new(TimeBuckling {
+                cap,
+                options,
+                schedule,
+                time: time.clone(),
+                vars: v,
+                check: (blf, s_nu, top),
+                blf_min,
+                shell0,
+                last: None,
+                shell: None,
+            });
+            let r = first_order(&state_model, &mut g).map_err(|e| DesignError::Uncertainty {
+                field: "uncertainty".into(),
+                message: format!("reliability analysis, state {index}: {e}"),
+            })?;
+            Ok(Some((g, r)))
+        })
+        .collect()
+}
+
+/// The buckling component of a state for [`state_form_with`]: screened or solved.
+fn prebuild<'a>(
+    f: Option<(Box<TimeBuckling<'a>>, FormResult)>,
+    screen: bool,
+) -> Option<Prebuilt<'a>> {
+    f.map(|(g, r)| {
+        if screen {
+            Prebuilt::Screened(Box::new(r))
+        } else {
+            Prebuilt::Solve(g)
+        }
+    })
+}
+
+/// Every state's buckling β₁ and FORM β (states with a [`Check::BucklingTime`], in state
+/// order; those FORM leaves out beyond [`FAR_BETA`] left out), screening off: the measurement
+/// behind [`SCREEN_DELTA_MEASURED`].
+///
+/// # Errors
+/// As [`reliability`].
+pub fn first_order_against_form(
+    cap: &Cap,
+    analysis: &Analysis,
+    schedule: &crate::schedule::Schedule,
+) -> Result<Vec<(usize, f64, f64)>, DesignError> {
+    let Some((model, drifts, v)) = prepare(cap)? else {
+        return Ok(Vec::new());
+    };
+    let per_state = state_checks(cap, analysis, schedule, v)?;
+    let firsts = first_orders(
+        cap,
+        &analysis.options,
+        schedule,
+        (&model, &drifts, v),
+        &per_state,
+    )?;
+    use rayon::prelude::*;
+    firsts
+        .into_par_iter()
+        .zip(per_state.par_iter())
+        .filter_map(|(f, (index, t_hours, _))| f.map(|f| (f, *index, *t_hours)))
+        .map(|((mut g, first), index, t_hours)| {
+            let state_model = model.drifted(&drifts, t_hours).map_err(rel_err)?;
+            match form(&state_model, g.as_mut(), &FormOptions::default()) {
+                Ok(r) => Ok(Some((index, first.beta, r.beta))),
+                // As in the run: a component FORM cannot converge beyond FAR_BETA is left out.
+                Err(kappe_reliability::Error::FormNotConverged { beta, .. }) if beta > FAR_BETA => {
+                    Ok(None)
+                }
+                Err(e) => Err(rel_err(e)),
+            }
+        })
+        .collect::<Result<Vec<_>, DesignError>>()
+        .map(|v| v.into_iter().flatten().collect())
 }
 
 /// FORM of each named limit state of one state in the state's (drifted) `model`, and the
@@ -963,9 +1223,31 @@ pub fn form_checks<'a>(
     t_hours: f64,
     seed: u64,
 ) -> Result<StateForm, kappe_reliability::Error> {
+    form_checks_with(model, checks, Vec::new(), index, t_hours, seed)
+}
+
+/// [`form_checks`] with `given` components (screened: first-order results) joining the state's
+/// system; the state is flagged `beta_first_order` when there are any.
+fn form_checks_with<'a>(
+    model: &Model,
+    checks: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)>,
+    given: Vec<(&'static str, FormResult)>,
+    index: usize,
+    t_hours: f64,
+    seed: u64,
+) -> Result<StateForm, kappe_reliability::Error> {
     let mut by_check = BTreeMap::new();
     let mut own = Vec::new();
     let mut results = Vec::new();
+    let first_order = !given.is_empty();
+    for (name, r) in given {
+        by_check
+            .entry(name.to_owned())
+            .and_modify(|b: &mut f64| *b = b.min(r.beta))
+            .or_insert(r.beta);
+        own.push(Component::from(&r));
+        results.push((name, r));
+    }
     for (name, mut g) in checks {
         let r = match form(model, g.as_mut(), &FormOptions::default()) {
             Ok(r) => r,
@@ -1001,6 +1283,7 @@ pub fn form_checks<'a>(
             beta: sys.beta,
             pf: sys.pf,
             beta_by_check: by_check,
+            beta_first_order: first_order,
         },
         results,
     ))
@@ -1045,24 +1328,80 @@ pub fn reliability(
     let per_state = state_checks(cap, analysis, schedule, v)?;
     let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
     let mut states = Vec::new();
+    let prepared = (&model, drifts.as_slice(), v);
+    let options = &analysis.options;
+    let mut firsts = if table.screening.unwrap_or(true) {
+        first_orders(cap, options, schedule, prepared, &per_state)?
+    } else {
+        per_state.iter().map(|_| None).collect()
+    };
+    // Screening: the least-β₁ state first; the largest component P_f it gives bounds the print's
+    // P_f from below, and a state whose N·Φ(−(β₁ − δ)) is below SCREEN_SHARE of that bound keeps
+    // its first-order result (module docs, "Screening").
+    let mut order: Vec<(usize, f64)> = firsts
+        .iter()
+        .enumerate()
+        .filter_map(|(i, f)| f.as_ref().map(|(_, r)| (i, r.beta)))
+        .collect();
+    order.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let mut screened = vec![false; per_state.len()];
+    let mut solved: Vec<Option<StateForm>> = per_state.iter().map(|_| None).collect();
+    if let Some(&(first, _)) = order.first()
+        && let (Some((index, t_hours, checks)), Some(f)) =
+            (per_state.get(first), firsts.get_mut(first))
+    {
+        let done = state_form_with(
+            cap,
+            options,
+            schedule,
+            prepared,
+            *index,
+            *t_hours,
+            checks,
+            prebuild(f.take(), false),
+        )?;
+        let bound = done
+            .iter()
+            .flat_map(|(_, rs)| rs.iter().map(|(_, r)| r.pf))
+            .fold(0.0_f64, f64::max);
+        let n = order.len() as f64;
+        for &(i, beta1) in order.iter().skip(1) {
+            let share = n * kappe_reliability::stdnormal::cdf(-(beta1 - SCREEN_DELTA));
+            if let Some(s) = screened.get_mut(i) {
+                *s = share < SCREEN_SHARE * bound;
+            }
+        }
+        if let Some(s) = solved.get_mut(first) {
+            *s = done;
+        }
+    }
+    let first = order.first().map(|&(i, _)| i);
     // States are independent (each its own FORM, its own re-solves): in parallel, collected in
     // state order, so the result is the sequential one bit for bit.
     use rayon::prelude::*;
-    let per_state: Vec<_> = per_state
+    let rest: Vec<Option<StateForm>> = per_state
         .par_iter()
-        .map(|(index, t_hours, checks)| {
-            state_form(
+        .zip(firsts.into_par_iter())
+        .zip(screened.into_par_iter())
+        .enumerate()
+        .map(|(i, (((index, t_hours, checks), f), screen))| {
+            if Some(i) == first {
+                return Ok(None);
+            }
+            state_form_with(
                 cap,
-                &analysis.options,
+                options,
                 schedule,
-                (&model, &drifts, v),
+                prepared,
                 *index,
                 *t_hours,
                 checks,
+                prebuild(f, screen),
             )
         })
-        .collect::<Result<Vec<_>, _>>()?;
-    for (state, rs) in per_state.into_iter().flatten() {
+        .collect::<Result<Vec<_>, DesignError>>()?;
+    let per_state = solved.into_iter().zip(rest).map(|(a, b)| a.or(b));
+    for (state, rs) in per_state.flatten() {
         let index = state.index;
         for (name, r) in rs {
             results.push((index, name, r));

@@ -92,6 +92,10 @@ pub struct UncertaintyTable {
     /// Crude Monte Carlo samples of the whole print (`kappe buildability` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub monte_carlo: Option<u64>,
+    /// The first-order screening of the states' buckling components (default true; false runs
+    /// FORM on every state, see `crate::analysis::reliability`, "Screening").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub screening: Option<bool>,
     /// The uncertain parameters, by the design file's names.
     #[serde(flatten)]
     pub parameters: BTreeMap<String, UncertaintySpec>,

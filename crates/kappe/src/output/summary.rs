@@ -250,6 +250,11 @@ pub struct StateEntry {
     /// β per check, e.g. `{"buckling": …, "sigma_min": …}` (only with `[uncertainty]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub beta_by_check: Option<std::collections::BTreeMap<String, f64>>,
+    /// The state's buckling β is the first-order β₁ at the drifted means, screened out of FORM
+    /// because it cannot move the print's P_f by more than 10⁻³ of it (docs/reliability.md,
+    /// "Screening"; only with `[uncertainty]`, absent when false).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub beta_first_order: bool,
 }
 
 /// The as-printed shape over the whole print (per state: `states[].crown_sag_m`,
@@ -541,6 +546,7 @@ impl Outcome {
                     beta: r.map(|r| r.beta),
                     pf: r.map(|r| r.pf),
                     beta_by_check: r.map(|r| r.beta_by_check.clone()),
+                    beta_first_order: r.is_some_and(|r| r.beta_first_order),
                 }
             })
             .collect();

@@ -900,3 +900,84 @@ fn form_of_the_strength_components_agrees_with_monte_carlo() {
         mc.interval
     );
 }
+
+/// The screening rule (docs/reliability.md, "Screening") against the unscreened run, on study
+/// No. 14's cap with E₀, Ė and γ uncertain (form_cost's row 1, every third state analysed to
+/// keep the test quick): some states are screened (else the test proves nothing); each screened
+/// state's first-order β₁ lies within the rule's δ of its FORM β; the component count and the
+/// governing component are the same; and the print's P_f moves by at most 2·SCREEN_SHARE of
+/// itself: SCREEN_SHARE is the rule's bound (the screened components together hold less than
+/// that share), and the other SCREEN_SHARE allows the seeded system sampler's change (it draws
+/// the same random numbers in both runs; only the screened components' slightly different
+/// P_f moves its picks of a component).
+#[test]
+fn screening_moves_the_print_pf_within_its_bound() {
+    use kappe::analysis::{SCREEN_DELTA, SCREEN_SHARE};
+    let mut d = study14(Some(-20.0));
+    d.analysis.states = StateSelection::Every(3);
+    if let Some(u) = d.uncertainty.as_mut() {
+        *u = table_of(
+            "\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+             \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+             \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+             [drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+        );
+    }
+    let mut nominal = d.clone();
+    nominal.uncertainty = None;
+    let out = run(&nominal, &Options::of(&nominal), &no_progress).unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let reliability = |screening: bool| {
+        let mut d = d.clone();
+        if let Some(u) = d.uncertainty.as_mut() {
+            u.screening = Some(screening);
+        }
+        let cap = design_cap(&d, kappe::Context::default()).unwrap();
+        kappe::analysis::reliability(&cap, analysis, &out.schedule)
+            .unwrap()
+            .unwrap()
+    };
+    let full = reliability(false);
+    let screened = reliability(true);
+    let flagged: Vec<_> = screened
+        .states
+        .iter()
+        .filter(|s| s.beta_first_order)
+        .collect();
+    assert!(
+        flagged.len() >= 3,
+        "{} of {} states screened",
+        flagged.len(),
+        screened.states.len()
+    );
+    assert!(full.states.iter().all(|s| !s.beta_first_order));
+    for s in &flagged {
+        let f = full.states.iter().find(|f| f.index == s.index).unwrap();
+        let (b1, b) = (s.beta_by_check["buckling"], f.beta_by_check["buckling"]);
+        assert!(
+            (b - b1).abs() <= SCREEN_DELTA,
+            "state {}: β₁ {b1} vs FORM {b} (δ {SCREEN_DELTA})",
+            s.index
+        );
+    }
+    assert_eq!(full.components, screened.components);
+    assert_eq!(
+        (full.governing_state, &full.governing_check),
+        (screened.governing_state, &screened.governing_check)
+    );
+    let moved = (screened.pf - full.pf).abs() / full.pf;
+    eprintln!(
+        "{} of {} states screened; print P_f {:.6e} (β {:.4}) vs unscreened {:.6e} (β {:.4}): \
+         relative change {moved:.2e}",
+        flagged.len(),
+        screened.states.len(),
+        screened.pf,
+        screened.beta,
+        full.pf,
+        full.beta
+    );
+    assert!(
+        moved <= 2.0 * SCREEN_SHARE,
+        "print P_f moved by {moved:.2e} of itself"
+    );
+}
