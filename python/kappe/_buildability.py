@@ -2,7 +2,10 @@
 ``kappe.buildability_monte_carlo(spec, samples, seed)`` samples every layer count of the print
 locally, or one Dask task per batch when given a ``dask.distributed.Client``. The batches are
 the library's (``kappe buildability`` runs the same functions in one batch), so the merged result
-equals the local run with the same seed, bit for bit, whatever the number of batches."""
+equals the local run with the same seed, bit for bit, whatever the number of batches. On Dask the
+spec's interpolation tables (the costly part) are built once, in parts over the workers (two per
+worker, consecutive layer counts of about equal work), joined, and shipped to every batch: no
+worker builds them again, and the shipped tables carry every number's bits."""
 
 from __future__ import annotations
 
@@ -15,10 +18,23 @@ from ._source import PathOrText, read_source
 __all__ = ["buildability_monte_carlo"]
 
 
-def _batch(text: str, samples: int, seed: int, index: int, count: int) -> str:
-    # A module-level function: Dask pickles it by reference to run it on the workers. Each
-    # worker process builds the spec's interpolation tables once and keeps them.
-    result: str = _kappe.buildability_mc_batch(text, samples, seed, index, count)
+def _table_part(text: str, index: int, count: int) -> str:
+    # One Dask task: part ``index`` of ``count`` of the spec's interpolation tables, as JSON.
+    result: str = _kappe.buildability_mc_table_part(text, index, count)
+    return result
+
+
+def _join(parts: List[str]) -> str:
+    # One Dask task: the print's tables from all parts, as JSON (what every batch is shipped).
+    result: str = _kappe.buildability_mc_tables_join(parts)
+    return result
+
+
+def _batch(text: str, samples: int, seed: int, index: int, count: int, tables: Optional[str] = None) -> str:
+    # A module-level function: Dask pickles it by reference to run it on the workers. A worker
+    # process keeps the spec's tables after its first batch: shipped ``tables`` when given, else
+    # built there.
+    result: str = _kappe.buildability_mc_batch(text, samples, seed, index, count, tables)
     return result
 
 
@@ -34,15 +50,22 @@ def buildability_monte_carlo(
     the ``monte_carlo`` block of buildability.json (``pf``, ``pf_interval``, ``failed_by``,
     ``state_pf``, failure-layer mean and std; ``seconds`` and ``resolves`` are 0, they belong
     to the workers). Locally one batch runs on the Rust threads (the GIL released); with
-    ``client`` the run is cut into ``batches`` (default: two per worker) tasks."""
+    ``client`` the run is cut into ``batches`` (default: two per worker) tasks, after the tasks
+    that build the tables for them all (two parts per worker, then one that joins them)."""
     text, _, _ = read_source(spec, "buildability")
     parts: List[str]
     if client is None:
         n = batches or 1
         parts = [_batch(text, samples, seed, i, n) for i in range(n)]
     else:
-        n = batches or 2 * max(1, len(client.scheduler_info().get("workers", {})))
-        futures = client.map(_batch, [text] * n, [samples] * n, [seed] * n, list(range(n)), [n] * n, pure=False)
+        workers = max(1, len(client.scheduler_info().get("workers", {})))
+        n = batches or 2 * workers
+        k = 2 * workers
+        table_parts = client.map(_table_part, [text] * k, list(range(k)), [k] * k, pure=False)
+        tables = client.submit(_join, table_parts, pure=False)
+        futures = client.map(
+            _batch, [text] * n, [samples] * n, [seed] * n, list(range(n)), [n] * n, [tables] * n, pure=False
+        )
         parts = client.gather(futures)
     merged: Dict[str, Any] = json.loads(_kappe.buildability_mc_merge(parts))
     return merged

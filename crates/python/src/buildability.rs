@@ -5,15 +5,16 @@
 //!
 //! A batch needs the spec's interpolation tables (`Surrogate::build`, the costly part: one shell
 //! solve per layer count and Chebyshev point). They are built once per process and spec text and
-//! kept for the process's life (a Dask worker builds them for its first batch, then only
-//! samples).
+//! kept for the process's life. On Dask one task builds them (`buildability_mc_tables`) and every
+//! batch gets them shipped (`tables=`): no worker solves them again, and the samples are the
+//! same bits (`SurrogateTables` carries every number's bit pattern).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
 use kappe::commands::buildability::{BuildabilitySpec, Resolved};
 use kappe::commands::buildability_reliability::{
-    Surrogate, monte_carlo_batch, monte_carlo_result, prepare,
+    Surrogate, SurrogateTables, monte_carlo_batch, monte_carlo_result, prepare, table_part_layers,
 };
 use kappe_reliability::{Batch, EventBatch, SamplingOptions};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -29,12 +30,33 @@ fn cache() -> &'static Mutex<HashMap<String, Tables>> {
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
-/// The checked spec and its tables (built on first use).
-fn tables(text: &str) -> PyResult<Tables> {
+/// The checked spec and its tables (built on first use, or made from `shipped` tables).
+fn tables(text: &str, shipped: Option<&str>) -> PyResult<Tables> {
     let lock = |_| PyRuntimeError::new_err("the buildability table cache was poisoned");
     if let Some(t) = cache().lock().map_err(lock)?.get(text) {
         return Ok(t.clone());
     }
+    let (r, table) = resolved(text)?;
+    let prepared = prepare(&r, &table).map_err(|e| design_error(&e))?;
+    let sur = match shipped {
+        Some(json) => {
+            let t: SurrogateTables =
+                serde_json::from_str(json).map_err(|e| json_err("Monte Carlo tables", e))?;
+            Surrogate::from_tables(&r, text, prepared, t)
+        }
+        None => Surrogate::build(&r, prepared),
+    }
+    .map_err(|e| design_error(&e))?;
+    let t = Arc::new((r, sur));
+    cache()
+        .lock()
+        .map_err(lock)?
+        .insert(text.to_owned(), t.clone());
+    Ok(t)
+}
+
+/// The spec `text` checked and resolved, with its `[uncertainty]` table.
+fn resolved(text: &str) -> PyResult<(Resolved, kappe::input::UncertaintyTable)> {
     let mut spec = BuildabilitySpec::parse(text).map_err(|e| design_error(&e))?;
     let Some(table) = spec.uncertainty.take() else {
         return Err(DesignError::new_err((
@@ -44,20 +66,52 @@ fn tables(text: &str) -> PyResult<Tables> {
             "allowed: a buildability spec with an [uncertainty] table".to_owned(),
         )));
     };
-    let r = spec.resolve().map_err(|e| design_error(&e))?;
-    let sur = Surrogate::build(&r, prepare(&r, &table).map_err(|e| design_error(&e))?)
-        .map_err(|e| design_error(&e))?;
-    let t = Arc::new((r, sur));
-    cache()
-        .lock()
-        .map_err(lock)?
-        .insert(text.to_owned(), t.clone());
-    Ok(t)
+    Ok((spec.resolve().map_err(|e| design_error(&e))?, table))
+}
+
+/// Part `index` of `count` of the interpolation tables of the buildability spec `text`
+/// (`table_part_layers`: consecutive layer counts, about equal work), as JSON: built on one
+/// worker; `buildability_mc_tables_join` makes the tables of the print from all parts.
+#[pyfunction]
+pub(crate) fn buildability_mc_table_part(
+    py: Python<'_>,
+    text: &str,
+    index: usize,
+    count: usize,
+) -> PyResult<String> {
+    if count == 0 || index >= count {
+        return Err(PyValueError::new_err(format!(
+            "table part {index} of {count}: allowed 0 ≤ index < count"
+        )));
+    }
+    let text = text.to_owned();
+    py.detach(move || -> PyResult<String> {
+        let (r, table) = resolved(&text)?;
+        let prepared = prepare(&r, &table).map_err(|e| design_error(&e))?;
+        let layers = table_part_layers(r.spec.object.max_layers, index, count);
+        let part = Surrogate::build_layers(&r, prepared, layers).map_err(|e| design_error(&e))?;
+        serde_json::to_string(&part.tables(&text)).map_err(|e| json_err("Monte Carlo tables", e))
+    })
+}
+
+/// The tables of the print from the JSON of its parts (`buildability_mc_table_part`, any
+/// order), as JSON to ship to the processes that sample (`buildability_mc_batch`'s `tables`).
+#[pyfunction]
+pub(crate) fn buildability_mc_tables_join(parts: Vec<String>) -> PyResult<String> {
+    let parsed = parts
+        .iter()
+        .map(|p| serde_json::from_str::<SurrogateTables>(p).map_err(|e| json_err("table part", e)))
+        .collect::<PyResult<Vec<_>>>()?;
+    let all = SurrogateTables::join(parsed).map_err(|e| design_error(&e))?;
+    serde_json::to_string(&all).map_err(|e| json_err("Monte Carlo tables", e))
 }
 
 /// Batch `index` of `count` of the print's crude Monte Carlo (`samples` in all, `seed`) of the
-/// buildability spec `text`, as the JSON of a `kappe_reliability::EventBatch`.
+/// buildability spec `text`, as the JSON of a `kappe_reliability::EventBatch`; `tables`: the
+/// spec's tables from `buildability_mc_tables` (used when this process has none yet), else
+/// they are built here.
 #[pyfunction]
+#[pyo3(signature = (text, samples, seed, index, count, tables=None))]
 pub(crate) fn buildability_mc_batch(
     py: Python<'_>,
     text: &str,
@@ -65,6 +119,7 @@ pub(crate) fn buildability_mc_batch(
     seed: u64,
     index: u64,
     count: u64,
+    tables: Option<String>,
 ) -> PyResult<String> {
     if count == 0 || index >= count {
         return Err(PyValueError::new_err(format!(
@@ -73,7 +128,7 @@ pub(crate) fn buildability_mc_batch(
     }
     let text = text.to_owned();
     py.detach(move || -> PyResult<String> {
-        let t = tables(&text)?;
+        let t = self::tables(&text, tables.as_deref())?;
         let (r, sur) = (&t.0, &t.1);
         let b = monte_carlo_batch(
             r,

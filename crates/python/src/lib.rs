@@ -61,6 +61,14 @@ fn _kappe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ceiling::ceiling_run_bay, m)?)?;
     m.add_function(wrap_pyfunction!(ceiling::ceiling_assemble, m)?)?;
     m.add_function(wrap_pyfunction!(ceiling::write_output, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        buildability::buildability_mc_table_part,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(
+        buildability::buildability_mc_tables_join,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_batch, m)?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_merge, m)?)?;
     Ok(())

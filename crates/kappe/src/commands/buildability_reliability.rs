@@ -36,7 +36,7 @@
 //! check_layers`], the deterministic check itself). [`Surrogate::verify`] compares the two.
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use kappe_reliability::{
     Batch, EvalError, Fallible, FormResult, Model, SamplingOptions, SamplingResult, SystemOptions,
@@ -287,15 +287,19 @@ fn bary(nodes: &[f64], weights: &[f64], s: f64, out: &mut [f64]) {
 }
 
 /// One layer count's tables at the interpolation points.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct StateTable {
     /// ln Λ per point (None: no buckling check, or a point without a positive factor).
+    #[serde(with = "bits::option")]
     log_blf: Option<Vec<f64>>,
     /// D_k per point (row-major: point j, layer k).
+    #[serde(with = "bits::option")]
     strength: Option<Vec<f64>>,
     /// S_k per point.
+    #[serde(with = "bits::option")]
     sliding: Option<Vec<f64>>,
     /// Ages of the layers at the nominal T, s.
+    #[serde(with = "bits")]
     ages: Vec<f64>,
     /// A point without a positive buckling factor: the state is re-solved at every sample.
     exact: bool,
@@ -315,14 +319,148 @@ pub struct Surrogate {
     t_scales: bool,
     /// Whether the reductions hold (else every evaluation is a re-solve).
     pub reducible: bool,
-    /// Per layer count n (index n − 1).
+    /// Per layer count n (index n − `first`).
     states: Vec<StateTable>,
+    /// The layer count of `states[0]` (1 but in a part, [`Surrogate::build_layers`]).
+    first: usize,
     sin_phi: f64,
     cos_phi: f64,
     /// Re-solves done for samples outside the box.
     pub fallbacks: std::sync::atomic::AtomicU64,
     /// Wall-clock seconds of building the tables.
     pub build_seconds: f64,
+}
+
+/// A [`Surrogate`]'s tables without its uncertain model: what a Dask client has built once and
+/// ships to its workers ([`Surrogate::tables`], [`Surrogate::from_tables`]), so that no worker
+/// solves them again. Every number travels as its bit pattern (JSON has no NaN, and the bits
+/// round-trip exactly), so a worker's samples equal the builder's bit for bit.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SurrogateTables {
+    /// The spec text the tables were built for (a worker refuses tables of another spec).
+    spec: String,
+    #[serde(with = "bits")]
+    nodes: Vec<f64>,
+    #[serde(with = "bits")]
+    weights: Vec<f64>,
+    #[serde(with = "bits")]
+    range: Vec<f64>,
+    t_scales: bool,
+    reducible: bool,
+    states: Vec<StateTable>,
+    /// The layer count of `states[0]`.
+    first: usize,
+    #[serde(with = "bits")]
+    phi: Vec<f64>,
+    build_seconds: f64,
+}
+
+/// The layer counts of part `index` of `count` of the tables of a `max`-layer print, for
+/// [`Surrogate::build_layers`]: consecutive ranges that tile 1..=`max` (some empty when
+/// `count` > `max`), cut so that each holds about the same Σ n (a layer count's table costs
+/// about in proportion to its layers).
+#[must_use]
+pub fn table_part_layers(
+    max: usize,
+    index: usize,
+    count: usize,
+) -> std::ops::RangeInclusive<usize> {
+    let count = count.max(1);
+    // The first layer count of part i: the least n with Σ_{m<n} m ≥ i/count of the whole.
+    let start = |i: usize| {
+        if i >= count {
+            return max + 1;
+        }
+        let goal = (max * (max + 1) / 2) * i / count;
+        (1..=max + 1)
+            .find(|&n| (n - 1) * n / 2 >= goal)
+            .unwrap_or(max + 1)
+    };
+    start(index)..=start(index + 1) - 1
+}
+
+impl SurrogateTables {
+    /// The tables of a whole print from its parts ([`Surrogate::build_layers`] of consecutive
+    /// layer-count ranges, in any order), so that the tables can be built on several workers.
+    ///
+    /// # Errors
+    /// Parts of different specs or frames, or ranges that do not tile 1, 2, … without gaps.
+    pub fn join(mut parts: Vec<SurrogateTables>) -> Result<SurrogateTables, DesignError> {
+        let bad = |m: String| uerr("uncertainty", format!("Monte Carlo table parts: {m}"));
+        parts.sort_by_key(|p| p.first);
+        let mut it = parts.into_iter();
+        let Some(mut all) = it.next() else {
+            return Err(bad("none given".into()));
+        };
+        if all.first != 1 {
+            return Err(bad(format!(
+                "the first part starts at layer count {}",
+                all.first
+            )));
+        }
+        for p in it {
+            fn frame(t: &SurrogateTables) -> (&str, Vec<u64>, bool, bool) {
+                let numbers = t
+                    .nodes
+                    .iter()
+                    .chain(&t.weights)
+                    .chain(&t.range)
+                    .chain(&t.phi);
+                (
+                    t.spec.as_str(),
+                    numbers.map(|x| x.to_bits()).collect(),
+                    t.t_scales,
+                    t.reducible,
+                )
+            }
+            if frame(&p) != frame(&all) {
+                return Err(bad("built for different specs".into()));
+            }
+            let next = all.first + all.states.len();
+            if all.reducible && p.first != next {
+                return Err(bad(format!(
+                    "a part starts at layer count {} where {next} was due",
+                    p.first
+                )));
+            }
+            all.states.extend(p.states);
+            all.build_seconds += p.build_seconds;
+        }
+        Ok(all)
+    }
+}
+
+/// `Vec<f64>` as the `u64` bit patterns of its values (see [`SurrogateTables`]).
+mod bits {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(v.iter().map(|x| x.to_bits()))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        Ok(Vec::<u64>::deserialize(d)?
+            .into_iter()
+            .map(f64::from_bits)
+            .collect())
+    }
+
+    /// The same for `Option<Vec<f64>>`.
+    pub mod option {
+        use serde::{Deserialize, Deserializer, Serializer};
+
+        pub fn serialize<S: Serializer>(v: &Option<Vec<f64>>, s: S) -> Result<S::Ok, S::Error> {
+            match v {
+                Some(v) => s.serialize_some(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()),
+                None => s.serialize_none(),
+            }
+        }
+
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<f64>>, D::Error> {
+            Ok(Option::<Vec<u64>>::deserialize(d)?
+                .map(|v| v.into_iter().map(f64::from_bits).collect()))
+        }
+    }
 }
 
 /// Print time of the state with n layers, h.
@@ -341,6 +479,32 @@ impl Surrogate {
     /// # Errors
     /// A failed solve, or a drift factor that is not positive within the print.
     pub fn build(r: &Resolved, prepared: Prepared) -> Result<Surrogate, DesignError> {
+        Self::build_layers(r, prepared, 1..=r.spec.object.max_layers)
+    }
+
+    /// [`Surrogate::build`] with the tables of the layer counts `layers` only: a part of the
+    /// tables for [`SurrogateTables::join`] (each layer count's table is the same function of
+    /// the spec wherever it is built), not a surrogate to sample.
+    ///
+    /// # Errors
+    /// As [`Surrogate::build`]; layer counts outside 1..=`max_layers`.
+    pub fn build_layers(
+        r: &Resolved,
+        prepared: Prepared,
+        layers: std::ops::RangeInclusive<usize>,
+    ) -> Result<Surrogate, DesignError> {
+        let max = r.spec.object.max_layers;
+        if *layers.start() < 1 || *layers.end() > max {
+            return Err(uerr(
+                "uncertainty",
+                format!(
+                    "Monte Carlo tables of layer counts {}..={}: allowed within 1..={max}",
+                    layers.start(),
+                    layers.end()
+                ),
+            ));
+        }
+        let first = *layers.start();
         let t0 = kappe_fe::clock::Instant::now();
         let nom = prepared.nominal;
         let time = &r.time;
@@ -403,7 +567,7 @@ impl Surrogate {
         };
         let (sin_phi, cos_phi) = phi.sin_cos();
         let states = if reducible {
-            (1..=max)
+            layers
                 .into_par_iter()
                 .map(|n| state_table(r, n, &rhos, phi, stress))
                 .collect::<Result<Vec<_>, _>>()?
@@ -418,10 +582,73 @@ impl Surrogate {
             t_scales,
             reducible,
             states,
+            first,
             sin_phi,
             cos_phi,
             fallbacks: std::sync::atomic::AtomicU64::new(0),
             build_seconds: t0.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The tables of this surrogate for the spec `text` it was built from, to ship to where
+    /// [`Surrogate::from_tables`] makes the same surrogate without solving them again.
+    #[must_use]
+    pub fn tables(&self, text: &str) -> SurrogateTables {
+        SurrogateTables {
+            spec: text.to_owned(),
+            nodes: self.nodes.clone(),
+            weights: self.weights.clone(),
+            range: self.range.to_vec(),
+            t_scales: self.t_scales,
+            reducible: self.reducible,
+            states: self.states.clone(),
+            first: self.first,
+            phi: vec![self.sin_phi, self.cos_phi],
+            build_seconds: self.build_seconds,
+        }
+    }
+
+    /// The surrogate of the spec `text` (resolved as `r`, its uncertain model `prepared`) from
+    /// `tables` built elsewhere by [`Surrogate::build`] on the same spec: the same numbers
+    /// without a solve.
+    ///
+    /// # Errors
+    /// Tables of another spec, or of another print (not one table per layer count).
+    pub fn from_tables(
+        r: &Resolved,
+        text: &str,
+        prepared: Prepared,
+        tables: SurrogateTables,
+    ) -> Result<Surrogate, DesignError> {
+        let max = r.spec.object.max_layers;
+        let bad = |m: &str| uerr("uncertainty", format!("shipped Monte Carlo tables: {m}"));
+        if tables.spec != text {
+            return Err(bad("they were built for another spec"));
+        }
+        let (Ok(range), [sin_phi, cos_phi]) =
+            (<[f64; 2]>::try_from(tables.range), tables.phi.as_slice())
+        else {
+            return Err(bad("malformed (range or friction angle)"));
+        };
+        if tables.reducible && (tables.first != 1 || tables.states.len() != max) {
+            return Err(bad(&format!(
+                "{} layer counts, the spec prints {max}",
+                tables.states.len()
+            )));
+        }
+        Ok(Surrogate {
+            prepared,
+            nodes: tables.nodes,
+            weights: tables.weights,
+            range,
+            t_scales: tables.t_scales,
+            reducible: tables.reducible,
+            states: tables.states,
+            first: 1,
+            sin_phi: *sin_phi,
+            cos_phi: *cos_phi,
+            fallbacks: std::sync::atomic::AtomicU64::new(0),
+            build_seconds: tables.build_seconds,
         })
     }
 
@@ -466,7 +693,7 @@ impl Surrogate {
         layer: Option<usize>,
     ) -> Result<StateValues, DesignError> {
         let nom = &self.prepared.nominal;
-        let table = match self.states.get(n.wrapping_sub(1)) {
+        let table = match self.states.get(n.wrapping_sub(self.first)) {
             Some(t) if self.reducible && !t.exact => t,
             _ => return exact_state(r, n, p),
         };

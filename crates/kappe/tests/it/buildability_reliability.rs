@@ -4,8 +4,8 @@
 
 use kappe::commands::buildability::{BuildabilitySpec, Resolved, run};
 use kappe::commands::buildability_reliability::{
-    PARAMETERS, Surrogate, exact_state, example_scatter, example_spec, monte_carlo,
-    monte_carlo_batch, monte_carlo_result, prepare, reliability,
+    PARAMETERS, Surrogate, SurrogateTables, exact_state, example_scatter, example_spec,
+    monte_carlo, monte_carlo_batch, monte_carlo_result, prepare, reliability, table_part_layers,
 };
 use kappe::input::DesignError;
 use kappe_reliability::{Batch, SamplingOptions};
@@ -134,6 +134,87 @@ fn monte_carlo_batches_merge_into_the_single_run_bit_for_bit() {
     let b = monte_carlo_result(&parts, 0, [0.0; 2]).unwrap();
     assert_eq!(a, b);
     assert!(a.failed_by.windows(2).all(|w| w[0] <= w[1]));
+}
+
+/// The table parts tile the layer counts for any number of parts, each about the same work.
+#[test]
+fn table_parts_tile_the_layer_counts() {
+    for max in [1usize, 2, 12, 60] {
+        for count in [1usize, 2, 3, 4, 7, 64] {
+            let parts: Vec<_> = (0..count)
+                .map(|i| table_part_layers(max, i, count))
+                .collect();
+            let all: Vec<usize> = parts.iter().flat_map(|p| p.clone()).collect();
+            assert_eq!(
+                all,
+                (1..=max).collect::<Vec<_>>(),
+                "{max} layers, {count} parts"
+            );
+            if count <= max {
+                // Σ n per part within one layer count's share of the even split.
+                let even = (max * (max + 1) / 2) as f64 / count as f64;
+                for p in &parts {
+                    let w: usize = p.clone().sum();
+                    assert!(
+                        (w as f64 - even).abs() <= max as f64,
+                        "{max}/{count}: {p:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Tables built once and shipped as JSON (what a Dask worker receives), whole or joined from
+/// parts built apart, sample the same bits as the tables they were built from; tables of
+/// another spec text, and parts with a gap, are refused by name.
+#[test]
+fn shipped_tables_sample_the_same_bits() {
+    let text = small(&scatter());
+    let (r, table) = resolved(&scatter());
+    let sur = Surrogate::build(&r, prepare(&r, &table).unwrap()).unwrap();
+    assert!(sur.reducible, "the test spec must use the tables");
+    let json = serde_json::to_string(&sur.tables(&text)).unwrap();
+    let shipped = |text: &str, json: &str| {
+        let t = serde_json::from_str(json).unwrap();
+        Surrogate::from_tables(&r, text, prepare(&r, &table).unwrap(), t)
+    };
+    let copy = shipped(&text, &json).unwrap();
+    let part = |layers| {
+        let s = Surrogate::build_layers(&r, prepare(&r, &table).unwrap(), layers).unwrap();
+        serde_json::from_str(&serde_json::to_string(&s.tables(&text)).unwrap()).unwrap()
+    };
+    let joined = SurrogateTables::join(vec![part(1..=4), part(9..=12), part(5..=8)]).unwrap();
+    let from_parts = shipped(&text, &serde_json::to_string(&joined).unwrap()).unwrap();
+    // Every state's values at a point off the nominal one, to the bit (Debug prints the
+    // shortest representation that reads back as the same f64).
+    let mut p = nominal(&r);
+    p.iter_mut().for_each(|v| *v *= 1.07);
+    for n in 1..=r.spec.object.max_layers {
+        let a = format!("{:?}", sur.state(&r, n, &p).unwrap());
+        assert_eq!(
+            a,
+            format!("{:?}", copy.state(&r, n, &p).unwrap()),
+            "state {n}"
+        );
+        assert_eq!(
+            a,
+            format!("{:?}", from_parts.state(&r, n, &p).unwrap()),
+            "state {n}"
+        );
+    }
+    let gap = SurrogateTables::join(vec![part(1..=4), part(6..=12)]).unwrap_err();
+    assert!(gap.to_string().contains("5 was due"), "{gap}");
+    let o = SamplingOptions::new(2500, 9);
+    let b = Batch { index: 0, count: 1 };
+    let a = monte_carlo_batch(&r, &sur, &o, b).unwrap();
+    let c = monte_carlo_batch(&r, &from_parts, &o, b).unwrap();
+    assert_eq!(
+        monte_carlo_result(&[a], 0, [0.0; 2]).unwrap(),
+        monte_carlo_result(&[c], 0, [0.0; 2]).unwrap()
+    );
+    let e = shipped(&format!("{text}\n# another spec\n"), &json).unwrap_err();
+    assert!(e.to_string().contains("another spec"), "{e}");
 }
 
 #[test]
