@@ -13,6 +13,9 @@
 //! (KIND: `smooth` = `kappe init`, `corrugated` = `kappe init --kind corrugated`; LENGTH the
 //! cap length, m).
 
+#[path = "common/caps.rs"]
+mod caps;
+
 use std::time::Instant;
 
 use kappe::analysis::{AnalysisOptions, coarsened_state, state_material, state_shell};
@@ -30,13 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (Some(kind), Some(length)) = (args.first(), args.get(1)) else {
         return Err("usage: blf_coarse KIND LENGTH STATE…".into());
     };
-    let mut design = match kind.as_str() {
-        "smooth" => kappe::Design::default(),
-        "corrugated" => kappe::Design::from_toml_str(kappe::commands::templates::CORRUGATED_TOML)?,
-        other => return Err(format!("KIND {other}: smooth or corrugated").into()),
-    };
-    design.cap.length = length.parse()?;
-    let cap = kappe::design_cap(&design, kappe::Context::default())?;
+    let cap = caps::cap_of(kind, length)?;
     let options = AnalysisOptions::default();
     let green = kappe::analysis::CapGreen::new(&cap)?;
     // Residual 1e-8: the eigenvalue error (≈ residual², relative) far below the differences

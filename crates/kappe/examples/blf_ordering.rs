@@ -8,6 +8,9 @@
 //! `cargo run --release -p kappe --example blf_ordering -- KIND LENGTH STATE…`
 //! (KIND `smooth` or `corrugated`, as `blf_coarse`).
 
+#[path = "common/caps.rs"]
+mod caps;
+
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -19,13 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (Some(kind), Some(length)) = (args.first(), args.get(1)) else {
         return Err("usage: blf_ordering KIND LENGTH STATE…".into());
     };
-    let mut design = match kind.as_str() {
-        "smooth" => kappe::Design::default(),
-        "corrugated" => kappe::Design::from_toml_str(kappe::commands::templates::CORRUGATED_TOML)?,
-        other => return Err(format!("KIND {other}: smooth or corrugated").into()),
-    };
-    design.cap.length = length.parse()?;
-    let cap = kappe::design_cap(&design, kappe::Context::default())?;
+    let cap = caps::cap_of(kind, length)?;
     let options = AnalysisOptions::default();
     let green = kappe::analysis::CapGreen::new(&cap)?;
     let shell = |top: usize| -> Result<kappe::analysis::StateShell, String> {

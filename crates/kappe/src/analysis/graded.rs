@@ -176,11 +176,14 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
     }
     // The network stores the layers top-down; keep that order.
     map.sort_unstable();
-    let nodes = map
-        .iter()
-        .filter_map(|&i| net.nodes.get(i).cloned())
-        .collect();
-    let reduced = State {
+    (with_nodes(state, &map), map)
+}
+
+/// `state` with only the network nodes `map` (sorted indices into its nodes), for the shell
+/// mesh alone (no trails or deviation edges).
+fn with_nodes(state: &State, map: &[usize]) -> State {
+    let net = &state.network;
+    State {
         index: state.index,
         layers_printed: state.layers_printed,
         top_layer: state.top_layer,
@@ -188,12 +191,14 @@ pub fn graded_state_map(state: &State, g: &Grading) -> (State, Vec<usize>) {
         factors: state.factors.clone(),
         column_force_per_weight: state.column_force_per_weight.clone(),
         network: crate::form::states::Network {
-            nodes,
+            nodes: map
+                .iter()
+                .filter_map(|&i| net.nodes.get(i).cloned())
+                .collect(),
             trails: Vec::new(),
             deviation_edges: Vec::new(),
         },
-    };
-    (reduced, map)
+    }
 }
 
 /// The state's network on a coarser mesh (issue 25, the coarse-mesh screen of
@@ -218,22 +223,7 @@ pub fn coarsened_state(state: &State, row_stride: usize, node_stride: usize) -> 
         })
         .collect();
     map.sort_unstable();
-    State {
-        index: state.index,
-        layers_printed: state.layers_printed,
-        top_layer: state.top_layer,
-        progress: state.progress,
-        factors: state.factors.clone(),
-        column_force_per_weight: state.column_force_per_weight.clone(),
-        network: crate::form::states::Network {
-            nodes: map
-                .iter()
-                .filter_map(|&i| net.nodes.get(i).cloned())
-                .collect(),
-            trails: Vec::new(),
-            deviation_edges: Vec::new(),
-        },
-    }
+    with_nodes(state, &map)
 }
 
 #[cfg(test)]
