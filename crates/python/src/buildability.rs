@@ -5,9 +5,10 @@
 //!
 //! A batch needs the spec's interpolation tables (`Surrogate::build`, the costly part: one shell
 //! solve per layer count and Chebyshev point). They are built once per process and spec text and
-//! kept for the process's life. On Dask one task builds them (`buildability_mc_tables`) and every
-//! batch gets them shipped (`tables=`): no worker solves them again, and the samples are the
-//! same bits (`SurrogateTables` carries every number's bit pattern).
+//! kept for the process's life. On Dask they are built in parts over the workers
+//! (`buildability_mc_table_part`), joined (`buildability_mc_tables_join`) and shipped to every
+//! batch (`tables=`): no worker solves them again, and the samples are the same bits
+//! (`SurrogateTables` carries every number's bit pattern).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -69,6 +70,16 @@ fn resolved(text: &str) -> PyResult<(Resolved, kappe::input::UncertaintyTable)> 
     Ok((spec.resolve().map_err(|e| design_error(&e))?, table))
 }
 
+/// That `index` names one of `count` parts of a run (`what`: "batch", "table part").
+fn check_part(what: &str, index: u64, count: u64) -> PyResult<()> {
+    if count == 0 || index >= count {
+        return Err(PyValueError::new_err(format!(
+            "{what} {index} of {count}: allowed 0 ≤ index < count"
+        )));
+    }
+    Ok(())
+}
+
 /// Part `index` of `count` of the interpolation tables of the buildability spec `text`
 /// (`table_part_layers`: consecutive layer counts, about equal work), as JSON: built on one
 /// worker; `buildability_mc_tables_join` makes the tables of the print from all parts.
@@ -79,11 +90,8 @@ pub(crate) fn buildability_mc_table_part(
     index: usize,
     count: usize,
 ) -> PyResult<String> {
-    if count == 0 || index >= count {
-        return Err(PyValueError::new_err(format!(
-            "table part {index} of {count}: allowed 0 ≤ index < count"
-        )));
-    }
+    // usize → u64 is lossless on every target PyO3 builds for.
+    check_part("table part", index as u64, count as u64)?;
     let text = text.to_owned();
     py.detach(move || -> PyResult<String> {
         let (r, table) = resolved(&text)?;
@@ -108,7 +116,7 @@ pub(crate) fn buildability_mc_tables_join(parts: Vec<String>) -> PyResult<String
 
 /// Batch `index` of `count` of the print's crude Monte Carlo (`samples` in all, `seed`) of the
 /// buildability spec `text`, as the JSON of a `kappe_reliability::EventBatch`; `tables`: the
-/// spec's tables from `buildability_mc_tables` (used when this process has none yet), else
+/// spec's tables from `buildability_mc_tables_join` (used when this process has none yet), else
 /// they are built here.
 #[pyfunction]
 #[pyo3(signature = (text, samples, seed, index, count, tables=None))]
@@ -121,11 +129,7 @@ pub(crate) fn buildability_mc_batch(
     count: u64,
     tables: Option<String>,
 ) -> PyResult<String> {
-    if count == 0 || index >= count {
-        return Err(PyValueError::new_err(format!(
-            "batch {index} of {count}: allowed 0 ≤ index < count"
-        )));
-    }
+    check_part("batch", index, count)?;
     let text = text.to_owned();
     py.detach(move || -> PyResult<String> {
         let t = self::tables(&text, tables.as_deref())?;

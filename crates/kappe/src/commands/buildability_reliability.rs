@@ -386,6 +386,21 @@ impl SurrogateTables {
     /// # Errors
     /// Parts of different specs or frames, or ranges that do not tile 1, 2, … without gaps.
     pub fn join(mut parts: Vec<SurrogateTables>) -> Result<SurrogateTables, DesignError> {
+        // What every part of one spec's tables shares (the numbers by their bits).
+        fn frame(t: &SurrogateTables) -> (&str, Vec<u64>, bool, bool) {
+            let numbers = t
+                .nodes
+                .iter()
+                .chain(&t.weights)
+                .chain(&t.range)
+                .chain(&t.phi);
+            (
+                t.spec.as_str(),
+                numbers.map(|x| x.to_bits()).collect(),
+                t.t_scales,
+                t.reducible,
+            )
+        }
         let bad = |m: String| uerr("uncertainty", format!("Monte Carlo table parts: {m}"));
         parts.sort_by_key(|p| p.first);
         let mut it = parts.into_iter();
@@ -399,20 +414,6 @@ impl SurrogateTables {
             )));
         }
         for p in it {
-            fn frame(t: &SurrogateTables) -> (&str, Vec<u64>, bool, bool) {
-                let numbers = t
-                    .nodes
-                    .iter()
-                    .chain(&t.weights)
-                    .chain(&t.range)
-                    .chain(&t.phi);
-                (
-                    t.spec.as_str(),
-                    numbers.map(|x| x.to_bits()).collect(),
-                    t.t_scales,
-                    t.reducible,
-                )
-            }
             if frame(&p) != frame(&all) {
                 return Err(bad("built for different specs".into()));
             }
@@ -609,8 +610,8 @@ impl Surrogate {
     }
 
     /// The surrogate of the spec `text` (resolved as `r`, its uncertain model `prepared`) from
-    /// `tables` built elsewhere by [`Surrogate::build`] on the same spec: the same numbers
-    /// without a solve.
+    /// `tables` built elsewhere on the same spec ([`Surrogate::build`], or its parts joined by
+    /// [`SurrogateTables::join`]): the same numbers without a solve.
     ///
     /// # Errors
     /// Tables of another spec, or of another print (not one table per layer count).
