@@ -201,8 +201,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 /// The `diag` table (module docs).
 fn diag() -> Result<(), Box<dyn std::error::Error>> {
-    use kappe::analysis::{GreenOptions, check_state};
-    use kappe::commands::buildability::object_shell;
+    use kappe::commands::buildability::aged_object_shell;
     use kappe_fe::{BucklingOptions, Linearisation, PathOptions, buckling, nonlinear_path};
     let n = 12;
     println!(
@@ -221,16 +220,7 @@ fn diag() -> Result<(), Box<dyn std::error::Error>> {
     for (segs, split) in [(24, 1), (48, 1), (96, 1), (48, 2)] {
         let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
         let r = BuildabilitySpec::from_toml_str(&text)?;
-        let (mut model, layers) = object_shell(&r, n);
-        let ages = r.schedule.ages(n);
-        check_state(
-            &mut model,
-            &layers,
-            &ages,
-            &r.time,
-            &GreenOptions::default(),
-            None,
-        )?;
+        let (model, _, _) = aged_object_shell(&r, n);
         let model = kappe_fe::refine::split(&model, split).model;
         let lba = buckling(
             &model,
@@ -385,21 +375,11 @@ fn ccx_limit(
 
 /// The `ccx` table (module docs).
 fn ccx_compare(segs: usize, n: usize) -> Result<(), Box<dyn std::error::Error>> {
-    use kappe::analysis::{GreenOptions, check_state};
-    use kappe::commands::buildability::object_shell;
+    use kappe::commands::buildability::aged_object_shell;
     use kappe_fe::{BucklingOptions, PathOptions, buckling, nonlinear_path, with_imperfection};
     let text = EXAMPLE_TOML.replace("# segments = 48", &format!("segments = {segs}"));
     let r = BuildabilitySpec::from_toml_str(&text)?;
-    let (mut model, layers) = object_shell(&r, n);
-    let ages = r.schedule.ages(n);
-    check_state(
-        &mut model,
-        &layers,
-        &ages,
-        &r.time,
-        &GreenOptions::default(),
-        None,
-    )?;
+    let (model, _, _) = aged_object_shell(&r, n);
     let dir = std::path::Path::new("target/ccx_collapse");
     std::fs::create_dir_all(dir)?;
     let lba = buckling(

@@ -7,7 +7,10 @@
 //! signs, 0 = the rule; `as_printed`: also each state's path from the as-printed shape,
 //! docs/collapse.md §8). STATES = 0 skips the table; the analysis with the check runs last
 //! unless `NO_FULL` is the fourth argument. `state=N` (repeatable) runs the table for those
-//! states alone, without either analysis.
+//! states alone, without either analysis. `first`: the table's check takes the state's mode and
+//! factor from the analysis's first-pass LBA (solved beforehand, untimed), as `analyze` does
+//! (docs/collapse.md §6, session 9), instead of its own LBA. `above=X`: the table's checks stop
+//! at λ* = X, as the states after the state rule's first batch do.
 
 use std::time::Instant;
 
@@ -16,7 +19,7 @@ mod measure;
 use measure::{cpu_seconds, load_average};
 
 use kappe::analysis::analyze;
-use kappe::analysis::{cap_state_collapse, cap_state_lba};
+use kappe::analysis::{FirstPass, cap_state_collapse, cap_state_collapse_from, cap_state_lba};
 use kappe::input::AnalysisOptions;
 use kappe::input::NonlinearSpec;
 
@@ -67,8 +70,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ..Default::default()
     };
     let as_printed = words.iter().any(|w| w == "as_printed");
+    let from_first = words.iter().any(|w| w == "first");
+    // `above=X`: the table's checks stop at X as the state rule's stopped states do
+    // (docs/collapse.md §3), to time one of them alone.
+    let above = words
+        .iter()
+        .find_map(|w| w.strip_prefix("above=")?.parse::<f64>().ok())
+        .unwrap_or(f64::INFINITY);
     println!(
-        "  {:>5} {:>8} {:>9} {:>12} {:>5} {:>5} {:>5} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7} {:>8} {:>7}",
+        "  {:>5} {:>8} {:>9} {:>14} {:>5} {:>5} {:>5} {:>9} {:>9} {:>9} {:>9} {:>7} {:>7} {:>8} {:>7}",
         "state",
         "BLF",
         "collapse",
@@ -113,14 +123,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 cr = cr.min(cpu() - c);
             }
         }
+        // With `first`: the check as `analyze` runs it, from the analysis's own first-pass
+        // LBA of the state (solved here, untimed, as the first pass solves it), so no LBA of
+        // its own; the ratio then is the check's cost on top of the analysis.
+        let kept = if from_first {
+            let mut guess = None;
+            let f = kappe::analysis::state_fe(
+                &cap,
+                &options.with_split_at_most(1),
+                q,
+                &mut guess,
+                &kappe::analysis::FeRequest::default(),
+            )?;
+            f.fe.buckling.factors.first().copied().zip(guess)
+        } else {
+            None
+        };
+        let first = kept.as_ref().map(|(factor, mode)| FirstPass {
+            factor: *factor,
+            mode,
+        });
         let (t, c0) = (Instant::now(), cpu());
-        let c = cap_state_collapse(&cap, &options, &spec, None, q, f64::INFINITY)?;
+        let c = cap_state_collapse_from(&cap, &options, &spec, None, q, above, first)?;
         let (tp, cp) = (t.elapsed().as_secs_f64(), cpu() - c0);
         if let Some(c) = c {
             println!(
-                "  {q:>5} {b:>8.4} {:>9.4} {:>12} {:>5} {:>5} {:>5} {tl:>9.2} {cl:>9.2} {tp:>9.2} {cp:>9.2} {:>7.1} {:>7.1} {cr:>8.2} {:>7.1}",
+                "  {q:>5} {b:>8.4} {:>9.4} {:>14} {:>5} {:>5} {:>5} {tl:>9.2} {cl:>9.2} {tp:>9.2} {cp:>9.2} {:>7.1} {:>7.1} {cr:>8.2} {:>7.1}",
                 c.factor,
-                c.mode.name(),
+                format!("{} {:+}", c.mode.name(), c.sign),
                 c.steps,
                 c.assemblies,
                 c.factorizations,

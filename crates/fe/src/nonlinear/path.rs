@@ -844,13 +844,15 @@ pub fn nonlinear_path(
     let mut rising = true;
     // (λ, μ) of the converged steps (from λ = 0) and the last eigenvector, with
     // `locate_by_eigenvalue`.
+    // μ at λ = 0 is computed when first needed, from λ = 0's factor (still at hand then): a
+    // path that the caller ends at its first step needs none, and every μ is the same as
+    // computed up front (the same start, the same factor, the same order).
     let mut mu_hist: Vec<(f64, f64)> = Vec::new();
     let mut mu_vec: Option<Vec<f64>> = None;
-    if options.locate_by_eigenvalue {
-        let (m, v) = eig_near_zero_from(&factor, &kvals, &problem, None, 8)?;
-        mu_hist.push((0.0, m));
-        mu_vec = Some(v);
-    }
+    let mu_at_zero = |factor: &Ldlt<'_>, kvals: &Tangent| -> Result<_, FeError> {
+        let (m, v) = eig_near_zero_from(factor, kvals, &problem, None, 8)?;
+        Ok(((0.0, m), v))
+    };
     let stop;
     loop {
         if steps.len() >= options.max_steps {
@@ -997,7 +999,18 @@ pub fn nonlinear_path(
         };
         let flow = on_step(&ps);
         steps.push(ps);
-        if options.locate_by_eigenvalue {
+        // The path ends at this step: μ would serve only the steps after it (a stopped state
+        // of the collapse rule ends after one or two steps, so this is a fair share of its
+        // solves).
+        let last = flow.is_break()
+            || (passed && options.stop_at_limit)
+            || c.lambda >= options.lambda_max * (1.0 - 1e-12);
+        if options.locate_by_eigenvalue && !last {
+            if mu_hist.is_empty() {
+                let (h, v) = mu_at_zero(&factor, &kvals)?;
+                mu_hist.push(h);
+                mu_vec = Some(v);
+            }
             let (m, v) = match located {
                 Some((m, v, _)) => (m, v),
                 None => eig_near_zero_from(&c.factor, &c.kvals, &problem, mu_vec.as_deref(), 4)?,

@@ -2,7 +2,7 @@
 //! self-weight, solved by `kappe_fe::buckling`; the lowest positive factor is the state's BLF.
 //! A shell model that is a mechanism is reported with the layers of its free motion.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use serde::Serialize;
 
@@ -442,6 +442,27 @@ fn guess_keys(
             let i = analysed.full_index(k)?;
             let layer = state.network.nodes.get(i)?.layer;
             Some((layer, i.checked_sub(*first.get(&layer)?)?))
+        })
+        .collect()
+}
+
+/// A mode kept as a [`ModeGuess`] (the analysis's first pass keeps each state's mode 1 so)
+/// on the nodes of `shell`, the ungraded shell of `state` (the collapse check's,
+/// docs/collapse.md §3): `None` unless every node of `shell` has a key, no two share one and
+/// the guess holds exactly these keys. Then the vector is the kept mode itself, node for node,
+/// and the guess was solved on this very mesh.
+pub fn mode_on_shell(state: &State, shell: &StateShell, mode: &ModeGuess) -> Option<Vec<[f64; 6]>> {
+    let analysed = crate::analysis::graded::AnalysedState::new(state, None);
+    let keys = guess_keys(state, &analysed, shell);
+    if keys.len() != mode.len() {
+        return None;
+    }
+    let mut seen = HashSet::with_capacity(keys.len());
+    keys.iter()
+        .map(|k| {
+            let k = (*k)?;
+            seen.insert(k).then_some(())?;
+            mode.get(&k).copied()
         })
         .collect()
 }

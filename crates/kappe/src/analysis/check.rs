@@ -727,6 +727,7 @@ fn analyze_from_fe(
         complete,
         Default::default(),
         Default::default(),
+        &Default::default(),
         context.stop_flag(),
     )?;
     analysis.refine_pending = pending;
@@ -764,7 +765,9 @@ fn analyze_all(
     let runs = fe_runs(options, cap.states.len());
     let n_fe = runs.iter().map(Vec::len).sum();
     // Each state's first-pass mode is kept (about 50 bytes a shell node) so the mesh-error pass
-    // continues from it instead of solving the print-layer mesh again (`state_refine`).
+    // continues from it instead of solving the print-layer mesh again (`state_refine`), and so
+    // the collapse check takes it as its imperfection's shape where its model is the same
+    // (`collapse::cap_state_lba_from`).
     let first_modes = std::sync::Mutex::new(std::collections::HashMap::new());
     // The first pass is the print-layer mesh alone; the mesh error is estimated afterwards over
     // all states together (`converge_fe`).
@@ -858,6 +861,7 @@ fn analyze_all(
         true,
         increments.into_inner().unwrap_or_default(),
         bending.into_inner().unwrap_or_default(),
+        &first_modes,
         stop,
     )
 }
@@ -868,7 +872,8 @@ fn analyze_all(
 /// whole-print passes run (the as-printed shape; a partial verdict, the designer's while its
 /// workers run, leaves them out rather than pay for them at every result). `increments`: the
 /// as-printed increments the buckling solves already gave (by state; the pass solves the rest);
-/// `solved_bending`: likewise a corrugated cap's stresses with their bending part.
+/// `solved_bending`: likewise a corrugated cap's stresses with their bending part;
+/// `first_modes`: the first pass's factor and mode 1 by state, for the collapse check.
 #[allow(clippy::too_many_arguments)]
 fn assemble(
     cap: &Cap,
@@ -880,6 +885,7 @@ fn assemble(
     complete: bool,
     increments: std::collections::HashMap<usize, Increment>,
     solved_bending: std::collections::HashMap<usize, (StressExtremes, Option<BendingSummary>)>,
+    first_modes: &std::collections::HashMap<usize, (f64, ModeGuess)>,
     stop: &AtomicBool,
 ) -> Result<Analysis, DesignError> {
     let cancelled = || {
@@ -1125,13 +1131,23 @@ fn assemble(
             .collect();
         let found = crate::analysis::collapse::cap_states_to_run(&bounds, false, &|top, above| {
             cancelled()?;
-            crate::analysis::collapse::cap_state_collapse(
+            // The first pass's own LBA of the state: no second solve where the model is the
+            // same (docs/collapse.md §3).
+            let first =
+                first_modes
+                    .get(&top)
+                    .map(|(factor, mode)| crate::analysis::collapse::FirstPass {
+                        factor: *factor,
+                        mode,
+                    });
+            crate::analysis::collapse::cap_state_collapse_from(
                 cap,
                 options,
                 &nonlinear,
                 green.as_ref(),
                 top,
                 above,
+                first,
             )
         })?;
         for (q, c) in found {

@@ -483,6 +483,19 @@ pub struct StateLba {
     pub linear: Option<kappe_fe::StaticResult>,
 }
 
+/// The analysis's own first-pass linear buckling solve of a state (`analysis::check`'s
+/// `first_modes`): its lowest factor on the print-layer mesh and its mode 1 by (layer, index
+/// in the layer). The collapse check takes them instead of solving the same model again where
+/// the model is the same: no graded mesh, no green-state model (docs/collapse.md §3).
+#[derive(Debug, Clone, Copy)]
+pub struct FirstPass<'a> {
+    /// The lowest factor of the print-layer mesh (not the mesh-converged estimate: the path
+    /// runs on this mesh).
+    pub factor: f64,
+    /// Mode 1 ([`crate::analysis::buckling::ModeGuess`]).
+    pub mode: &'a crate::analysis::buckling::ModeGuess,
+}
+
 /// The model of cap state `top` and its linear buckling solve (the first half of
 /// [`cap_state_collapse`]; public so the benchmark can time the LBA alone). `None`: no shell
 /// (one layer).
@@ -492,11 +505,38 @@ pub fn cap_state_lba(
     green: Option<&crate::analysis::green::CapGreen>,
     top: usize,
 ) -> Result<Option<StateLba>, DesignError> {
+    cap_state_lba_from(cap, options, green, top, None)
+}
+
+/// [`cap_state_lba`], taking the factor and mode from `first` instead of solving when they
+/// were solved on the same model: no graded mesh, no green-state model (whose moduli and
+/// solve the analysis does not keep), and the kept mode covers exactly this shell's nodes
+/// ([`crate::analysis::buckling::mode_on_shell`]). Otherwise it solves, as
+/// [`cap_state_lba`]. With `first` taken, [`StateLba::linear`] is `None` (the collapse check
+/// needs it only with a green-state model).
+pub fn cap_state_lba_from(
+    cap: &crate::form::cap::Cap,
+    options: &crate::input::analysis::AnalysisOptions,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    first: Option<FirstPass<'_>>,
+) -> Result<Option<StateLba>, DesignError> {
     let state = cap.state(top)?;
     let mat = crate::analysis::buckling::state_material(cap, options, top, green);
     let Ok(shell) = crate::analysis::shell::state_shell(&state, &mat, options.row_stride) else {
         return Ok(None);
     };
+    let same_model = green.is_none() && options.grading.is_none();
+    if let Some(first) = first.filter(|f| same_model && f.factor.is_finite() && f.factor > 0.0)
+        && let Some(mode) = crate::analysis::buckling::mode_on_shell(&state, &shell, first.mode)
+    {
+        return Ok(Some(StateLba {
+            state,
+            shell,
+            lba: Some((first.factor, mode)),
+            linear: None,
+        }));
+    }
     let lba = match kappe_fe::buckling(
         &shell.model,
         &kappe_fe::BucklingOptions {
@@ -556,12 +596,26 @@ pub fn cap_state_collapse(
     top: usize,
     above: f64,
 ) -> Result<Option<Collapse>, DesignError> {
+    cap_state_collapse_from(cap, options, spec, green, top, above, None)
+}
+
+/// [`cap_state_collapse`] from the analysis's own first-pass LBA of the state where it is the
+/// same model ([`cap_state_lba_from`]): no second linear buckling solve.
+pub fn cap_state_collapse_from(
+    cap: &crate::form::cap::Cap,
+    options: &crate::input::analysis::AnalysisOptions,
+    spec: &crate::input::nonlinear::NonlinearSpec,
+    green: Option<&crate::analysis::green::CapGreen>,
+    top: usize,
+    above: f64,
+    first: Option<FirstPass<'_>>,
+) -> Result<Option<Collapse>, DesignError> {
     let Some(StateLba {
         state,
         shell,
         lba,
         linear,
-    }) = cap_state_lba(cap, options, green, top)?
+    }) = cap_state_lba_from(cap, options, green, top, first)?
     else {
         return Ok(None);
     };

@@ -63,9 +63,10 @@ pub use check::{
     state_fe, state_fe_refine,
 };
 pub use collapse::{
-    CURVE_POINTS, CollapseMode, CollapseOptions, ObjectIncrements, StateLba, cap_as_printed_shift,
-    cap_state_collapse, cap_state_lba, collapse_factor, object_as_printed_shift,
-    object_as_printed_shift_cached, shifted,
+    CURVE_POINTS, CollapseMode, CollapseOptions, FirstPass, ObjectIncrements, StateLba,
+    cap_as_printed_shift, cap_state_collapse, cap_state_collapse_from, cap_state_lba,
+    cap_state_lba_from, collapse_factor, object_as_printed_shift, object_as_printed_shift_cached,
+    shifted,
 };
 pub use graded::{Grading, coarsened_state, graded_rows, graded_state};
 pub use green::{

@@ -536,6 +536,16 @@ pub struct Buildability {
     pub monte_carlo: Option<crate::commands::buildability_reliability::PrintMonteCarlo>,
 }
 
+/// The `n`-layer object of `r` with every element's modulus at its layer's age (the model
+/// that [`check_layers`] solves at `n` layers, before any solve), its elements' layers and
+/// the layers' ages: the one setup of the collapse tests and benchmarks.
+pub fn aged_object_shell(r: &Resolved, n: usize) -> (ShellModel, Vec<ElementLayers>, Vec<f64>) {
+    let (mut model, layers) = object_shell(r, n);
+    let ages = r.schedule.ages(n);
+    crate::analysis::set_aged_moduli(&mut model, &layers, &ages, &r.time);
+    (model, layers, ages)
+}
+
 /// Check one layer count.
 pub fn check_layers(r: &Resolved, n: usize) -> Result<BuildState, DesignError> {
     check_layers_warm(r, n, None).map(|(s, _)| s)

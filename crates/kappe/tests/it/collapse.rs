@@ -3,7 +3,9 @@
 
 use kappe::analysis::CollapseMode;
 use kappe::analysis::FailureMode;
-use kappe::commands::buildability::{BuildabilitySpec, EXAMPLE_TOML, Resolved, check_layers};
+use kappe::commands::buildability::{
+    BuildabilitySpec, EXAMPLE_TOML, Resolved, aged_object_shell, check_layers,
+};
 use kappe::input::DesignError;
 
 /// The Wolfs cylinder (the `kappe init --kind buildability` example) with 24 segments instead
@@ -12,31 +14,6 @@ fn cylinder(nonlinear: &str) -> Resolved {
     let text = EXAMPLE_TOML.replace("# segments = 48", "segments = 24");
     BuildabilitySpec::from_toml_str(&format!("{text}\n[analysis.nonlinear]\n{nonlinear}\n"))
         .unwrap()
-}
-
-/// The `n`-layer state of `r` with every element's modulus at its layer's age (the green
-/// check's model, as `kappe buildability` builds it), with its elements' layers and the ages.
-fn aged_state(
-    r: &Resolved,
-    n: usize,
-) -> (
-    kappe_fe::ShellModel,
-    Vec<kappe::analysis::ElementLayers>,
-    Vec<f64>,
-) {
-    use kappe::analysis::{GreenOptions, check_state};
-    let (mut model, layers) = kappe::commands::buildability::object_shell(r, n);
-    let ages = r.schedule.ages(n);
-    check_state(
-        &mut model,
-        &layers,
-        &ages,
-        &r.time,
-        &GreenOptions::default(),
-        None,
-    )
-    .unwrap();
-    (model, layers, ages)
 }
 
 /// The lowest linear buckling factor and mode of `model`.
@@ -108,7 +85,7 @@ fn collapse_tends_to_the_linear_buckling_factor_as_w0_vanishes() {
 fn the_co_rotational_initial_stress_stiffness_is_the_linear_buckling_one() {
     use kappe_fe::{Linearisation, linearised_critical_factor};
     let r = BuildabilitySpec::from_toml_str(EXAMPLE_TOML).unwrap();
-    let (model, _, _) = aged_state(&r, 12);
+    let (model, _, _) = aged_object_shell(&r, 12);
     let model = kappe_fe::refine::split(&model, 2).model;
     let lba = lowest_mode(&model).factors[0];
     let sigma = linearised_critical_factor(
@@ -221,12 +198,11 @@ fn a_state_fails_by_collapse_below_collapse_min() {
 ///   start's (the shift is a fraction of a millimetre on a 40 mm wall).
 #[test]
 fn the_as_printed_start_locks_in_the_staged_sag() {
-    use kappe::analysis::{object_as_printed_shift, set_aged_moduli};
+    use kappe::analysis::object_as_printed_shift;
     use kappe::commands::buildability::object_shell;
     let r = cylinder("imperfection = 0.0");
     let shift_of = |n: usize| {
-        let (mut own, layers) = object_shell(&r, n);
-        set_aged_moduli(&mut own, &layers, &r.schedule.ages(n), &r.time);
+        let (own, _, _) = aged_object_shell(&r, n);
         let own_u = kappe_fe::linear_static(&own).unwrap().displacements;
         let shift = object_as_printed_shift(
             n,
@@ -326,7 +302,7 @@ fn a_straight_wall_runs_one_sign() {
 fn the_fast_path_finds_the_full_paths_collapse_factor() {
     use kappe::analysis::{CollapseOptions, collapse_factor};
     let r = cylinder("material = false");
-    let (model, layers, ages) = aged_state(&r, 12);
+    let (model, layers, ages) = aged_object_shell(&r, 12);
     let b = lowest_mode(&model);
     let (lba, mode) = (b.factors[0], &b.modes[0]);
     let run = |w0: f64, fast_path: bool| {
@@ -387,7 +363,7 @@ fn the_fast_path_finds_the_full_paths_collapse_factor() {
 fn a_path_stops_above_the_least_collapse_factor_with_a_lower_bound() {
     use kappe::analysis::{CollapseOptions, collapse_factor};
     let r = cylinder("material = false");
-    let (model, layers, ages) = aged_state(&r, 12);
+    let (model, layers, ages) = aged_object_shell(&r, 12);
     let b = lowest_mode(&model);
     let run = |stop_above: f64| {
         collapse_factor(
@@ -433,15 +409,11 @@ fn a_path_stops_above_the_least_collapse_factor_with_a_lower_bound() {
 #[test]
 fn cached_as_printed_increments_give_the_same_shift() {
     use kappe::analysis::{
-        ObjectIncrements, object_as_printed_shift, object_as_printed_shift_cached, set_aged_moduli,
+        ObjectIncrements, object_as_printed_shift, object_as_printed_shift_cached,
     };
     use kappe::commands::buildability::object_shell;
     let r = cylinder("imperfection = 0.0\nstart = \"as_printed\"");
-    let own_of = |n: usize| {
-        let (mut own, layers) = object_shell(&r, n);
-        set_aged_moduli(&mut own, &layers, &r.schedule.ages(n), &r.time);
-        own
-    };
+    let own_of = |n: usize| aged_object_shell(&r, n).0;
     let shell = |k: usize| object_shell(&r, k);
     let ages = |k: usize| r.schedule.ages(k);
     let cache = ObjectIncrements::default();
@@ -455,4 +427,113 @@ fn cached_as_printed_increments_give_the_same_shift() {
     assert_eq!(cached, fresh);
     // The shift is not trivially zero (the test would then prove nothing).
     assert!(cached.iter().any(|d| d[2] != 0.0));
+}
+
+/// The collapse check of a cap state takes the analysis's own first-pass LBA (its factor on
+/// the print-layer mesh and mode 1, docs/collapse.md §3) instead of solving the same model
+/// again, and gets the collapse factor of its own solve; a kept mode that does not cover the
+/// shell node for node is not taken.
+#[test]
+fn the_collapse_check_takes_the_first_pass_mode_on_the_same_mesh() {
+    use kappe::analysis::{
+        FeRequest, FirstPass, cap_state_collapse, cap_state_collapse_from, cap_state_lba,
+        cap_state_lba_from, state_fe,
+    };
+    // A short cap keeps the test quick.
+    let design = kappe::Design::from_toml_str("[cap]\nlength = 0.2\n").expect("design");
+    let cap = kappe::design_cap(&design, kappe::Context::default()).expect("cap");
+    let options = design.analysis.clone();
+    let q = cap.states.len() - 1;
+    // The first pass as `analyze` runs it (print-layer mesh alone).
+    let mut guess = None;
+    let f = state_fe(
+        &cap,
+        &options.with_split_at_most(1),
+        q,
+        &mut guess,
+        &FeRequest::default(),
+    )
+    .expect("first pass");
+    let factor = f.fe.buckling.factors[0];
+    let mode = guess.expect("first-pass mode");
+    let first = Some(FirstPass {
+        factor,
+        mode: &mode,
+    });
+    let own = cap_state_lba(&cap, &options, None, q).unwrap().unwrap();
+    let taken = cap_state_lba_from(&cap, &options, None, q, first)
+        .unwrap()
+        .unwrap();
+    // Taken, not solved: no static solution of its own.
+    assert!(taken.linear.is_none() && own.linear.is_some());
+    let (l_own, m_own) = own.lba.unwrap();
+    let (l_taken, m_taken) = taken.lba.unwrap();
+    assert_eq!(l_taken, factor);
+    // The first pass stops at a relative residual of 1e-5 (mesh error controlled), the own
+    // solve at 1e-8: a Ritz value lies within its relative residual of an eigenvalue, so 1e-4
+    // is ten times that bound.
+    assert!((l_taken / l_own - 1.0).abs() < 1e-4, "{l_taken} vs {l_own}");
+    // The same mode up to sign and scale. An eigenvector's error is its residual over the
+    // relative gap to the next mode; 1e-3 of the largest translation allows a gap down to 1 %,
+    // and moves the imperfection by 1e-3·w0 (1 µm), far below the path's 1e-3 in λ.
+    let unit = |m: &[[f64; 6]]| {
+        let s = m
+            .iter()
+            .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
+            .fold(0.0, f64::max);
+        m.iter()
+            .map(|d| [d[0] / s, d[1] / s, d[2] / s])
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (unit(&m_own), unit(&m_taken));
+    let dot: f64 = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| x[0] * y[0] + x[1] * y[1] + x[2] * y[2])
+        .sum();
+    let sign = dot.signum();
+    let diff = a
+        .iter()
+        .zip(&b)
+        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - sign * y[k]).abs()))
+        .fold(0.0, f64::max);
+    assert!(diff < 1e-3, "mode differs by {diff}");
+    // The collapse factors agree within the path's location tolerance, 1e-3 in λ.
+    let spec = kappe::input::NonlinearSpec::default();
+    let c_own = cap_state_collapse(&cap, &options, &spec, None, q, f64::INFINITY)
+        .unwrap()
+        .unwrap();
+    let c_taken = cap_state_collapse_from(&cap, &options, &spec, None, q, f64::INFINITY, first)
+        .unwrap()
+        .unwrap();
+    println!(
+        "state {q}: LBA {l_own:.6} / {l_taken:.6}, mode Δ {diff:.1e}; collapse {:.6} ({}) / {:.6} ({})",
+        c_own.factor,
+        c_own.mode.name(),
+        c_taken.factor,
+        c_taken.mode.name()
+    );
+    assert!(
+        (c_taken.factor / c_own.factor - 1.0).abs() < 1e-3,
+        "{} vs {}",
+        c_taken.factor,
+        c_own.factor
+    );
+    // A kept mode missing one node is not this mesh's: the check solves its own LBA.
+    let mut partial = mode.clone();
+    let key = *partial.keys().next().unwrap();
+    partial.remove(&key);
+    let solved = cap_state_lba_from(
+        &cap,
+        &options,
+        None,
+        q,
+        Some(FirstPass {
+            factor,
+            mode: &partial,
+        }),
+    )
+    .unwrap()
+    .unwrap();
+    assert!(solved.linear.is_some());
 }
