@@ -39,6 +39,14 @@
 //! hold less than SCREEN_SHARE of the print's P_f, and none can govern. δ = [`SCREEN_DELTA`], the
 //! largest |β_FORM − β₁| measured over every state of two caps times a safety factor. The other
 //! states run FORM from the cached solve. `[uncertainty] screening = false` runs FORM on all.
+//!
+//! # The 1-D reduction
+//!
+//! With the moduli E₀ + Ė·h(a_k) at fixed ages, λ = E₀·Λ(Ė/E₀), so FORM of a [`TimeBuckling`]
+//! component runs on a model of g with ln Λ(ln(Ė/E₀)) replaced by a Hermite cubic through the
+//! last two re-solves, and the shell is re-solved only at the design points the model proposes,
+//! until one meets FORM's own tolerances with the true g and gradient ([`time_buckling_form`];
+//! docs/reliability.md, "The 1-D reduction").
 
 use std::collections::BTreeMap;
 
