@@ -151,18 +151,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let cap = design_cap(&d, kappe::Context::default())?;
             let pairs = kappe::analysis::first_order_against_form(&cap, analysis, &out.schedule)?;
             println!("{name}: state | beta_1 | beta_FORM | beta_FORM - beta_1");
-            let mut worst = (0.0_f64, 0);
+            let (mut worst, mut ratio) = ((0.0_f64, 0), (0.0_f64, 0));
             for (i, b1, b) in &pairs {
                 println!("  {i} | {b1:.4} | {b:.4} | {:+.4}", b - b1);
                 if (b - b1).abs() > worst.0 {
                     worst = ((b - b1).abs(), *i);
                 }
+                // The measurement behind δ(β₁) (`SCREEN_DELTA_RATIO`).
+                let r = (b - b1).abs() / b1.max(1.0);
+                if r > ratio.0 {
+                    ratio = (r, *i);
+                }
             }
             println!(
-                "{name}: {} states, largest |beta_FORM - beta_1| = {:.4} (state {})",
+                "{name}: {} states, largest |beta_FORM - beta_1| = {:.4} (state {}), largest \
+                 |beta_FORM - beta_1|/max(1, beta_1) = {:.4} (state {})",
                 pairs.len(),
                 worst.0,
-                worst.1
+                worst.1,
+                ratio.0,
+                ratio.1
             );
             continue;
         }

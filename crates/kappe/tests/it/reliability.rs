@@ -912,7 +912,7 @@ fn form_of_the_strength_components_agrees_with_monte_carlo() {
 /// P_f moves its picks of a component).
 #[test]
 fn screening_moves_the_print_pf_within_its_bound() {
-    use kappe::analysis::{SCREEN_DELTA, SCREEN_SHARE};
+    use kappe::analysis::{SCREEN_SHARE, screen_delta};
     let mut d = study14(Some(-20.0));
     d.analysis.states = StateSelection::Every(3);
     if let Some(u) = d.uncertainty.as_mut() {
@@ -955,9 +955,10 @@ fn screening_moves_the_print_pf_within_its_bound() {
         let f = full.states.iter().find(|f| f.index == s.index).unwrap();
         let (b1, b) = (s.beta_by_check["buckling"], f.beta_by_check["buckling"]);
         assert!(
-            (b - b1).abs() <= SCREEN_DELTA,
-            "state {}: β₁ {b1} vs FORM {b} (δ {SCREEN_DELTA})",
-            s.index
+            (b - b1).abs() <= screen_delta(b1),
+            "state {}: β₁ {b1} vs FORM {b} (δ {})",
+            s.index,
+            screen_delta(b1)
         );
     }
     assert_eq!(full.components, screened.components);
