@@ -1039,3 +1039,44 @@ fn reduced_form_of_the_time_buckling_equals_form_on_the_re_solves() {
     );
     assert!(3 * reduced < full, "{reduced} re-solves vs FORM's {full}");
 }
+
+/// The same comparison on a subset of the default cap's states (`kappe init`'s design with
+/// form_cost's time model and scatter: E(t) = 10 MPa + 1 kPa/s·t, E₀ lognormal cov 0.2, Ė
+/// lognormal cov 0.3, γ normal cov 0.05, E₀ drifting −20 %/h; the states at 50 % of the print
+/// and the last): β within 10⁻⁵·max(1, β) of FORM's on the re-solves, for the reason above
+/// (measured over all 111 states by `form_cost -- 0 3 reduced`: 2.0·10⁻⁸), with fewer re-solves.
+/// Ignored in the quick suite: the default cap's nominal run and FORM on its re-solves take
+/// about 40 s on the shared machine (`cargo test --release -p kappe --test it -- --ignored
+/// reduced_form_equals`).
+#[test]
+#[ignore = "about 40 s: the default cap's run and FORM on its re-solves"]
+fn reduced_form_equals_form_on_default_cap_states() {
+    let d = Design::from_toml_str(
+        "name = \"default\"\n[analysis]\nstates = \"50%\"\n[material.time]\nmodel = \"linear\"\n\
+         youngs_modulus = 1.0e7\nyoungs_modulus_rate = 1000.0\n[uncertainty]\n\
+         \"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.2 }\n\
+         \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+    )
+    .unwrap();
+    let mut nominal = d.clone();
+    nominal.uncertainty = None;
+    let out = run(&nominal, &Options::of(&nominal), &no_progress).unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let rows = kappe::analysis::reduced_against_form(&cap, analysis, &out.schedule).unwrap();
+    assert!(rows.len() >= 2, "only {} states compared", rows.len());
+    let (mut reduced, mut full) = (0, 0);
+    for r in &rows {
+        let diff = (r.beta_reduced - r.beta_form).abs() / r.beta_form.abs().max(1.0);
+        eprintln!(
+            "state {}: β {} reduced ({} re-solves) vs {} FORM ({}): {diff:.1e}",
+            r.index, r.beta_reduced, r.solves_reduced, r.beta_form, r.solves_form
+        );
+        assert!(diff <= 1e-5, "state {}: {r:?}", r.index);
+        reduced += r.solves_reduced;
+        full += r.solves_form;
+    }
+    assert!(reduced < full, "{reduced} re-solves vs FORM's {full}");
+}
