@@ -96,6 +96,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // `form_cost 0 13 delta`: per state, the buckling component's first-order β₁ against FORM's
     // β (screening off), and the largest |β − β₁| (the screening rule's δ).
     let delta = std::env::args().nth(3).is_some_and(|a| a == "delta");
+    // `form_cost 0 13 reduced`: per state, the time buckling component by the 1-D reduction
+    // (`time_buckling_form`) against FORM on the re-solves: β and the re-solves of each.
+    let reduced = std::env::args().nth(3).is_some_and(|a| a == "reduced");
     for (name, row) in all.into_iter().filter(|(_, r)| rows.contains(*r)) {
         let mut d = match row {
             '1' | 'a' => cap(false)?,
@@ -107,6 +110,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         {
             u.screening = Some(false);
         }
+        if reduced {
+            let mut nominal = d.clone();
+            nominal.uncertainty = None;
+            let out = run(&nominal, &Options::of(&nominal), &no_progress)?;
+            let analysis = out.analysis.as_ref().ok_or("no analysis")?;
+            let cap = design_cap(&d, kappe::Context::default())?;
+            let rows = kappe::analysis::reduced_against_form(&cap, analysis, &out.schedule)?;
+            println!(
+                "{name}: state | beta_reduced | beta_FORM | difference | re-solves reduced | FORM"
+            );
+            let (mut worst, mut rel) = (0.0_f64, 0.0_f64);
+            let (mut sr, mut sf) = (0, 0);
+            for r in &rows {
+                let diff = r.beta_reduced - r.beta_form;
+                println!(
+                    "  {} | {:.7} | {:.7} | {diff:+.2e} | {} | {}",
+                    r.index, r.beta_reduced, r.beta_form, r.solves_reduced, r.solves_form
+                );
+                worst = worst.max(diff.abs());
+                rel = rel.max(diff.abs() / r.beta_form.abs().max(1.0));
+                sr += r.solves_reduced;
+                sf += r.solves_form;
+            }
+            println!(
+                "{name}: {} states, largest |beta_reduced - beta_FORM| = {worst:.2e} \
+                 ({rel:.2e} of max(1, beta)); re-solves {sr} reduced vs {sf} FORM \
+                 ({:.2} vs {:.2} per state)",
+                rows.len(),
+                sr as f64 / rows.len().max(1) as f64,
+                sf as f64 / rows.len().max(1) as f64
+            );
+            continue;
+        }
         if delta {
             let mut nominal = d.clone();
             nominal.uncertainty = None;
@@ -115,18 +151,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let cap = design_cap(&d, kappe::Context::default())?;
             let pairs = kappe::analysis::first_order_against_form(&cap, analysis, &out.schedule)?;
             println!("{name}: state | beta_1 | beta_FORM | beta_FORM - beta_1");
-            let mut worst = (0.0_f64, 0);
+            let (mut worst, mut ratio) = ((0.0_f64, 0), (0.0_f64, 0));
             for (i, b1, b) in &pairs {
                 println!("  {i} | {b1:.4} | {b:.4} | {:+.4}", b - b1);
                 if (b - b1).abs() > worst.0 {
                     worst = ((b - b1).abs(), *i);
                 }
+                // The measurement behind δ(β₁) (`SCREEN_DELTA_RATIO`).
+                let r = (b - b1).abs() / b1.max(1.0);
+                if r > ratio.0 {
+                    ratio = (r, *i);
+                }
             }
             println!(
-                "{name}: {} states, largest |beta_FORM - beta_1| = {:.4} (state {})",
+                "{name}: {} states, largest |beta_FORM - beta_1| = {:.4} (state {}), largest \
+                 |beta_FORM - beta_1|/max(1, beta_1) = {:.4} (state {})",
                 pairs.len(),
                 worst.0,
-                worst.1
+                worst.1,
+                ratio.0,
+                ratio.1
             );
             continue;
         }

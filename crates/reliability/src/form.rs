@@ -322,6 +322,67 @@ pub fn form<L: LimitState + ?Sized>(
     })
 }
 
+/// Whether `u` is a design point of `limit_state` within `options`' tolerances, judged as
+/// [`form`] judges its iterates but with ε_G relative to `g_scale` (|G| at the start of the
+/// search that proposed `u`): one evaluation with gradient at x = T⁻¹(u). `Some` holds the
+/// result as [`form`] returns it (sensitivities included), `None` says the tolerances are not
+/// met there. For searches that propose the design point from a cheaper model of the limit
+/// state and need the true one only to confirm it.
+///
+/// # Errors
+/// A `u` of the wrong length, bad options, a failed or non-finite evaluation, a zero gradient.
+pub fn form_at<L: LimitState + ?Sized>(
+    model: &Model,
+    limit_state: &mut L,
+    u: &[f64],
+    g_scale: f64,
+    options: &FormOptions,
+) -> Result<Option<FormResult>> {
+    check_options(options)?;
+    if u.len() != model.len() {
+        return Err(Error::DimensionMismatch {
+            what: "FORM point",
+            expected: model.len(),
+            got: u.len(),
+        });
+    }
+    if !(g_scale > 0.0 && g_scale.is_finite()) {
+        return Err(Error::InvalidOption {
+            field: "g_scale",
+            value: g_scale,
+            allowed: "finite and > 0",
+        });
+    }
+    let mut ev = Evaluator {
+        model,
+        ls: limit_state,
+        fd_step: options.fd_step,
+        evaluations: 0,
+        gradient_evaluations: 0,
+    };
+    let x = model.x_from_u(u);
+    let (g, grad_x) = ev.value_and_gradient(&x, None)?;
+    let grad_u = model.gradient_to_standard(u, &grad_x);
+    let gnorm = norm(&grad_u);
+    if !(gnorm > 0.0 && gnorm.is_finite()) {
+        return Err(Error::ZeroGradient { x });
+    }
+    let alpha: Vec<f64> = grad_u.iter().map(|d| -d / gnorm).collect();
+    let beta = dot(&alpha, u);
+    let g_res = g.abs() / g_scale;
+    let u_res = norm(
+        &u.iter()
+            .zip(&alpha)
+            .map(|(ui, ai)| ui - beta * ai)
+            .collect::<Vec<_>>(),
+    );
+    // The tolerances exactly as `form` applies them.
+    Ok(
+        (g_res <= options.g_tolerance && u_res <= options.u_tolerance * norm(u).max(1.0))
+            .then(|| finish(model, u.to_vec(), x, g, alpha, beta, g_res, u_res, 1, &ev)),
+    )
+}
+
 #[allow(clippy::too_many_arguments)]
 fn finish<L: ?Sized>(
     model: &Model,

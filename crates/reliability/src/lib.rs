@@ -44,7 +44,7 @@ pub mod variable;
 
 pub use drift::{Drift, DriftStep};
 pub use error::{Error, EvalError, Result};
-pub use form::{FormOptions, FormResult, form};
+pub use form::{FormOptions, FormResult, form, form_at};
 pub use limit_state::{Fallible, LimitState, WithGradient};
 pub use model::{Correlation, Model};
 pub use sampling::{

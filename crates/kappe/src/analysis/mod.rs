@@ -73,7 +73,8 @@ pub use green::{
     CapGreen, ElementLayers, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli,
 };
 pub use reliability::{
-    Check, GreenField, SCREEN_DELTA, SCREEN_SHARE, Vars, check_form, first_order_against_form,
-    limit_state, prepare, reliability, scaled_ages, state_form,
+    Check, GreenField, ReducedAgainstForm, SCREEN_DELTA_RATIO, SCREEN_SAFETY, SCREEN_SHARE, Vars,
+    check_form, first_order_against_form, limit_state, prepare, reduced_against_form, reliability,
+    scaled_ages, screen_delta, state_form,
 };
 pub use shell::{StateShell, state_shell};

@@ -36,9 +36,18 @@
 //! N·Φ(−(β₁ − δ)) < [`SCREEN_SHARE`]·P_b (N the states with such a component) keeps its
 //! first-order result as its buckling component, flagged `beta_first_order`: with
 //! |β_FORM − β₁| ≤ δ, each such state's P_f is below SCREEN_SHARE·P_b/N, so all of them together
-//! hold less than SCREEN_SHARE of the print's P_f, and none can govern. δ = [`SCREEN_DELTA`], the
-//! largest |β_FORM − β₁| measured over every state of two caps times a safety factor. The other
+//! hold less than SCREEN_SHARE of the print's P_f, and none can govern. δ = [`screen_delta`]:
+//! the largest |β_FORM − β₁|/max(1, β₁) measured over every state of two caps, times a safety
+//! factor, times max(1, β₁). The other
 //! states run FORM from the cached solve. `[uncertainty] screening = false` runs FORM on all.
+//!
+//! # The 1-D reduction
+//!
+//! With the moduli E₀ + Ė·h(a_k) at fixed ages, λ = E₀·Λ(Ė/E₀), so FORM of a [`TimeBuckling`]
+//! component runs on a model of g with ln Λ(ln(Ė/E₀)) replaced by a Hermite cubic through the
+//! last two re-solves, and the shell is re-solved only at the design points the model proposes,
+//! until one meets FORM's own tolerances with the true g and gradient ([`time_buckling_form`];
+//! docs/reliability.md, "The 1-D reduction").
 
 use std::collections::BTreeMap;
 
@@ -65,14 +74,20 @@ pub const FAR_BETA: f64 = 8.0;
 /// Samples of each state's own series system (its few checks).
 const STATE_SYSTEM_SAMPLES: u64 = 4_000;
 
-/// δ of the screening rule: the allowance on the first-order β₁ of a state's buckling component
-/// (`SCREEN_DELTA_MEASURED` × [`SCREEN_SAFETY`]).
-pub const SCREEN_DELTA: f64 = SCREEN_DELTA_MEASURED * SCREEN_SAFETY;
+/// δ(β₁) of the screening rule, the allowance on the first-order β₁ of a state's buckling
+/// component: [`SCREEN_SAFETY`] × [`SCREEN_DELTA_RATIO`] × max(1, β₁). The error of β₁ is the
+/// curvature of ln λ over the distance to the design point, so it grows with β₁ (measured
+/// 0.8–3.7 % of β over both caps); a constant δ sized at the largest β₁ measured was loose
+/// where the rule decides (β₁ ≈ 6–9 on the default cap).
+pub fn screen_delta(beta1: f64) -> f64 {
+    SCREEN_SAFETY * SCREEN_DELTA_RATIO * beta1.max(1.0)
+}
 
-/// The largest |β_FORM − β₁| measured over every analysed state of the default cap and study
-/// No. 14's cap with the time parameters uncertain (`form_cost -- 0 d`, docs/reliability.md,
-/// "Screening").
-pub const SCREEN_DELTA_MEASURED: f64 = 0.651;
+/// The largest |β_FORM − β₁|/max(1, β₁) measured over every analysed state of the default cap
+/// (0.0401, state 8, β₁ 17.83) and study No. 14's cap (0.0261) with the time parameters
+/// uncertain (`form_cost -- 0 13 delta`, docs/reliability.md, "Screening"), rounded up;
+/// β₁ < β_FORM at every one of the 155 states.
+pub const SCREEN_DELTA_RATIO: f64 = 0.0402;
 
 /// Safety factor on the measured δ: the measured caps span E₀ cov 0.15–0.2, Ė cov 0.3; a design
 /// with larger scatter bends ln λ more, and the factor covers that until it is measured.
@@ -375,6 +390,9 @@ pub struct TimeBuckling<'a> {
     /// The state's shell and solver, built on first use and kept for every iterate (see
     /// [`crate::analysis::blf_sensitivity::TimeShell`]).
     pub shell: Option<crate::analysis::blf_sensitivity::TimeShell>,
+    /// Every re-solve so far: E₀, Ė, λ and ∂λ/∂Ė (the data of the 1-D model of
+    /// [`time_buckling_form`]).
+    pub solves: Vec<[f64; 4]>,
 }
 
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
@@ -407,6 +425,14 @@ impl TimeBuckling<'_> {
             Some(shell) => shell.solve(&ages, &dages, &time, RESOLVE_TOLERANCE)?,
             None => None,
         };
+        if let Some((l, dl)) = solved {
+            self.solves.push([
+                time.youngs_modulus.initial,
+                time.youngs_modulus.rate,
+                l,
+                dl[1],
+            ]);
+        }
         solved.ok_or_else(|| {
             format!(
                 "state {top}: no positive buckling factor at E₀ = {} Pa, Ė = {} Pa/s, print \
@@ -510,6 +536,203 @@ impl kappe_reliability::LimitState for TimeBuckling<'_> {
         let (g, d) = self.cached(x)?;
         grad.iter_mut().zip(&d).for_each(|(o, v)| *o = *v);
         Ok(Some(g))
+    }
+}
+
+/// Most design points [`time_buckling_form`] proposes from its 1-D model before it falls back
+/// to FORM on the re-solves: the model of ln Λ is a Hermite cubic through the last two
+/// re-solves, whose error falls faster than quadratically as they close in (measured: 2–3
+/// proposals per state, docs/reliability.md, "Cost").
+pub const REDUCED_PROPOSALS: usize = 6;
+
+/// Tolerances of FORM on the 1-D model (closed form, analytic gradient): 10 times below
+/// FORM's on the true limit state, so the model's own residual takes at most a tenth of the
+/// check at the proposed point. (HL-RF on the model stalls near 2·10⁻⁸·‖u‖ in u, measured on
+/// study No. 14's states, so 10⁻⁸ is out of its reach.)
+const MODEL_TOLERANCE: f64 = 1e-7;
+
+/// HL-RF iterations allowed on the 1-D model: on these curved surfaces HL-RF converges
+/// linearly at a rate near 0.9 per iterate (measured on study No. 14's states: 10⁻² to 3·10⁻⁸
+/// in 100), and an iterate of the model costs microseconds, not a re-solve.
+const MODEL_ITERATIONS: usize = 5_000;
+
+impl TimeBuckling<'_> {
+    /// Whether λ is E₀·Λ(Ė/E₀) for this component: the moduli are E₀ + Ė·h(a) (every law; h
+    /// fixed by the ages), so homogeneous of degree 1 in (E₀, Ė), and λ with them (K linear in
+    /// the moduli, K_G in the static solution's membrane forces, which do not change when every
+    /// modulus is scaled by one factor). Not with the print speed uncertain (it moves the ages)
+    /// or a modulus cap (it holds some moduli), nor without a positive rate (Λ at ρ = 0 only).
+    fn reducible(&self) -> bool {
+        self.vars.speed.is_none()
+            && self.time.youngs_modulus.max.is_none()
+            && (self.vars.e0t.is_some() || self.vars.rate.is_some())
+            && self.time.youngs_modulus.rate > 0.0
+    }
+}
+
+/// The buckling limit state of [`TimeBuckling`] with ln Λ(y), y = ln(Ė/E₀), replaced by the
+/// Hermite cubic through two re-solves (their value and exact slope), or the tangent line of
+/// one: g = (BLF₀/λ⁰)·E₀·e^{L(y)}·(γ₀/γ)·(1 + s_ν(ν − ν₀)) − BLF_min. Closed form.
+struct ReducedBuckling {
+    vars: Vars,
+    /// Nominal E₀ and Ė (where they are not random).
+    e0: f64,
+    rate0: f64,
+    /// BLF₀/λ⁰, s_ν, BLF_min.
+    k: f64,
+    s_nu: f64,
+    blf_min: f64,
+    /// (y, L, dL/dy) of the re-solves the model goes through, the latest last.
+    points: Vec<[f64; 3]>,
+}
+
+impl ReducedBuckling {
+    /// L(y) and L′(y).
+    fn model(&self, y: f64) -> (f64, f64) {
+        match self.points.as_slice() {
+            [.., [y1, f1, d1], [y2, f2, d2]] if (y2 - y1).abs() > 1e-12 => {
+                // Cubic Hermite on [y1, y2] in t = (y − y1)/h (also outside it).
+                let h = y2 - y1;
+                let t = (y - y1) / h;
+                let (t2, t3) = (t * t, t * t * t);
+                let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+                let h10 = t3 - 2.0 * t2 + t;
+                let h01 = -2.0 * t3 + 3.0 * t2;
+                let h11 = t3 - t2;
+                let v = h00 * f1 + h10 * h * d1 + h01 * f2 + h11 * h * d2;
+                let dh00 = 6.0 * t2 - 6.0 * t;
+                let dh10 = 3.0 * t2 - 4.0 * t + 1.0;
+                let dh01 = -6.0 * t2 + 6.0 * t;
+                let dh11 = 3.0 * t2 - 2.0 * t;
+                let dv = (dh00 * f1 + dh01 * f2) / h + dh10 * d1 + dh11 * d2;
+                (v, dv)
+            }
+            [.., [y1, f1, d1]] => (f1 + d1 * (y - y1), *d1),
+            [] => (0.0, 0.0),
+        }
+    }
+
+    fn eval(&self, x: &[f64], grad: &mut [f64]) -> f64 {
+        let v = self.vars;
+        let at =
+            |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+        let e0 = at(v.e0t, self.e0);
+        let rate = at(v.rate, self.rate0);
+        let (l, dl) = self.model((rate / e0).ln());
+        let lambda = e0 * l.exp();
+        let gamma = at(v.gamma, v.gamma0);
+        let rg = gamma / v.gamma0;
+        let nu = at(v.nu, v.nu0);
+        let lin = 1.0 + self.s_nu * (nu - v.nu0);
+        let val = self.k * lambda / rg * lin;
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        let mut set = |i: Option<usize>, d: f64| {
+            if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+                *g = d;
+            }
+        };
+        // ∂λ/∂E₀ = λ(1 − L′)/E₀, ∂λ/∂Ė = λL′/Ė.
+        set(v.e0t, val * (1.0 - dl) / e0);
+        set(v.rate, val * dl / rate);
+        set(v.gamma, -val / gamma);
+        set(v.nu, self.k * lambda / rg * self.s_nu);
+        val - self.blf_min
+    }
+}
+
+/// FORM of a [`TimeBuckling`] component, through its 1-D reduction where λ = E₀·Λ(Ė/E₀)
+/// ([`TimeBuckling::reducible`]; docs/reliability.md, "Cost"): the limit state depends on the
+/// shell only through L(y) = ln Λ, y = ln(Ė/E₀), a function of one variable whose value and
+/// exact slope L′ = Ė·(∂λ/∂Ė)/λ every re-solve gives. FORM runs on a model of g with L
+/// replaced by the Hermite cubic through the last two re-solves (the tangent line of the
+/// first, at the means), and the true limit state is re-solved only at the design point the
+/// model proposes: when FORM's tolerances hold there with the true g and gradient (ε_G
+/// relative to |g| at the means, as FORM's), that point is the result
+/// ([`kappe_reliability::form_at`]), otherwise the re-solve joins the model and the next
+/// point is proposed. After [`REDUCED_PROPOSALS`], or where the reduction does not hold, FORM
+/// runs on the re-solves as before. `evaluations` and `iterations` of the result count the
+/// re-solves and the proposals.
+///
+/// # Errors
+/// As [`form`].
+pub fn time_buckling_form(
+    model: &Model,
+    g: &mut TimeBuckling<'_>,
+) -> Result<FormResult, kappe_reliability::Error> {
+    use kappe_reliability::LimitState;
+    let options = FormOptions::default();
+    let before = g.solves.len();
+    if !g.reducible() {
+        return form(model, g, &options);
+    }
+    // The point FORM starts from (as `form` and `first_order` map it, so the cache holds).
+    let u0 = model.u_from_x(&model.means());
+    let x0 = model.x_from_u(&u0);
+    let g0 = g
+        .value(&x0)
+        .map_err(|source| kappe_reliability::Error::LimitState {
+            x: x0.clone(),
+            source,
+        })?;
+    let (Some(shell0), true) = (g.shell0, g0 != 0.0 && g0.is_finite()) else {
+        return form(model, g, &options);
+    };
+    let mut reduced = ReducedBuckling {
+        vars: g.vars,
+        e0: g.time.youngs_modulus.initial,
+        rate0: g.time.youngs_modulus.rate,
+        k: g.check.0 / shell0,
+        s_nu: g.check.1,
+        blf_min: g.blf_min,
+        points: Vec::new(),
+    };
+    let tight = FormOptions {
+        g_tolerance: MODEL_TOLERANCE,
+        u_tolerance: MODEL_TOLERANCE,
+        max_iterations: MODEL_ITERATIONS,
+        ..FormOptions::default()
+    };
+    for proposal in 1..=REDUCED_PROPOSALS {
+        reduced.points = g
+            .solves
+            .iter()
+            .rev()
+            .take(2)
+            .rev()
+            .filter(|[e0, rate, l, _]| *e0 > 0.0 && *rate > 0.0 && *l > 0.0)
+            .map(|[e0, rate, l, dl]| [(rate / e0).ln(), (l / e0).ln(), rate * dl / l])
+            .collect();
+        let mut m = WithGradient(|x: &[f64], grad: &mut [f64]| reduced.eval(x, grad));
+        // A model FORM cannot solve: FORM on the re-solves decides, as before.
+        let Ok(proposed) = form(model, &mut m, &tight) else {
+            break;
+        };
+        match kappe_reliability::form_at(model, g, &proposed.u_star, g0.abs(), &options) {
+            Ok(Some(mut r)) => {
+                r.iterations = proposal;
+                r.evaluations = g.solves.len() - before;
+                r.gradient_evaluations = r.evaluations;
+                return Ok(r);
+            }
+            Ok(None) => {}
+            // A proposal the shell cannot be solved at (e.g. far out while the model is a
+            // tangent line): FORM on the re-solves decides, as before.
+            Err(_) => break,
+        }
+    }
+    form(model, g, &options)
+}
+
+/// [`time_buckling_form`], with a component whose FORM does not converge beyond [`FAR_BETA`]
+/// left out (None), as every component is.
+fn time_form(
+    model: &Model,
+    g: &mut TimeBuckling<'_>,
+) -> Result<Option<FormResult>, kappe_reliability::Error> {
+    match time_buckling_form(model, g) {
+        Ok(r) => Ok(Some(r)),
+        Err(kappe_reliability::Error::FormNotConverged { beta, .. }) if beta > FAR_BETA => Ok(None),
+        Err(e) => Err(e),
     }
 }
 
@@ -977,6 +1200,7 @@ fn state_form_with<'a>(
     };
     let mut named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = Vec::new();
     let mut given = Vec::new();
+    let mut first_order = false;
     for &check in checks {
         if let Check::GreenLayers(_) = check {
             if let Some((field, time)) = &field {
@@ -984,48 +1208,66 @@ fn state_form_with<'a>(
             }
             continue;
         }
-        if let (Check::BucklingTime { .. }, Some(p)) = (check, prebuilt.take()) {
-            match p {
-                Prebuilt::Solve(g) => named.push((check.name(), g)),
-                Prebuilt::Screened(r) => given.push((check.name(), *r)),
+        // The time buckling component: screened, or FORM through its 1-D reduction
+        // (`time_buckling_form`), from the solve at the means when `first_order` made it.
+        let time_buckling = match (check, prebuilt.take(), &time) {
+            (Check::BucklingTime { .. }, Some(Prebuilt::Screened(r)), _) => {
+                given.push((check.name(), *r));
+                first_order = true;
+                continue;
+            }
+            (Check::BucklingTime { .. }, Some(Prebuilt::Solve(g)), _) => Some(g),
+            (
+                Check::BucklingTime {
+                    blf,
+                    s_nu,
+                    top,
+                    shell0,
+                },
+                None,
+                Some(time),
+            ) => Some(Box::new(TimeBuckling {
+                cap,
+                options,
+                schedule,
+                time: time.clone(),
+                vars: v,
+                check: (blf, s_nu, top),
+                blf_min: k.blf_min,
+                shell0,
+                last: None,
+                shell: None,
+                solves: Vec::new(),
+            })),
+            _ => None,
+        };
+        if let Some(mut g) = time_buckling {
+            if let Some(r) = time_form(&state_model, g.as_mut()).map_err(rel_err)? {
+                given.push((check.name(), r));
             }
             continue;
         }
         named.push((
             check.name(),
-            match (check, &time) {
-                (
-                    Check::BucklingTime {
-                        blf,
-                        s_nu,
-                        top,
-                        shell0,
-                    },
-                    Some(time),
-                ) => Box::new(TimeBuckling {
-                    cap,
-                    options,
-                    schedule,
-                    time: time.clone(),
-                    vars: v,
-                    check: (blf, s_nu, top),
-                    blf_min: k.blf_min,
-                    shell0,
-                    last: None,
-                    shell: None,
-                }),
-                _ => Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
-                    limit_state(check, v, limits, x, grad)
-                })),
-            },
+            Box::new(WithGradient(move |x: &[f64], grad: &mut [f64]| {
+                limit_state(check, v, limits, x, grad)
+            })),
         ));
     }
     if named.is_empty() && given.is_empty() {
         return Ok(None);
     }
-    form_checks_with(&state_model, named, given, index, t_hours, seed)
-        .map(Some)
-        .map_err(rel_err)
+    form_checks_with(
+        &state_model,
+        named,
+        given,
+        first_order,
+        index,
+        t_hours,
+        seed,
+    )
+    .map(Some)
+    .map_err(rel_err)
 }
 
 /// The first-order β₁ of a state's buckling component, G = ln(BLF/BLF_min) linearised in u-space
@@ -1143,6 +1385,7 @@ fn first_orders<'a>(
                 shell0,
                 last: None,
                 shell: None,
+                solves: Vec::new(),
             });
             let r = first_order(&state_model, &mut g).map_err(|e| DesignError::Uncertainty {
                 field: "uncertainty".into(),
@@ -1169,7 +1412,7 @@ fn prebuild<'a>(
 
 /// Every state's buckling β₁ and FORM β (states with a [`Check::BucklingTime`], in state
 /// order; those FORM leaves out beyond [`FAR_BETA`] left out), screening off: the measurement
-/// behind [`SCREEN_DELTA_MEASURED`].
+/// behind [`SCREEN_DELTA_RATIO`].
 ///
 /// # Errors
 /// As [`reliability`].
@@ -1196,14 +1439,96 @@ pub fn first_order_against_form(
         .filter_map(|(f, (index, t_hours, _))| f.map(|f| (f, *index, *t_hours)))
         .map(|((mut g, first), index, t_hours)| {
             let state_model = model.drifted(&drifts, t_hours).map_err(rel_err)?;
-            match form(&state_model, g.as_mut(), &FormOptions::default()) {
-                Ok(r) => Ok(Some((index, first.beta, r.beta))),
-                // As in the run: a component FORM cannot converge beyond FAR_BETA is left out.
+            // As in the run: a component FORM cannot converge beyond FAR_BETA is left out.
+            Ok(time_form(&state_model, g.as_mut())
+                .map_err(rel_err)?
+                .map(|r| (index, first.beta, r.beta)))
+        })
+        .collect::<Result<Vec<_>, DesignError>>()
+        .map(|v| v.into_iter().flatten().collect())
+}
+
+/// One state's time buckling component by [`time_buckling_form`] and by FORM on the re-solves
+/// ([`reduced_against_form`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReducedAgainstForm {
+    /// State index.
+    pub index: usize,
+    /// β by the 1-D reduction and its re-solves (the means' included).
+    pub beta_reduced: f64,
+    /// Re-solves of the reduction.
+    pub solves_reduced: usize,
+    /// β by FORM on the re-solves (iHL-RF from the means).
+    pub beta_form: f64,
+    /// Re-solves of FORM.
+    pub solves_form: usize,
+}
+
+/// Every state's time buckling component (states with a [`Check::BucklingTime`], in state
+/// order) by [`time_buckling_form`] and by FORM on the re-solves, each from a fresh limit state
+/// (the solve at the means counted): what the reduction saves and that it finds the same β.
+/// States where either leaves the component out beyond [`FAR_BETA`] are left out.
+///
+/// # Errors
+/// As [`reliability`].
+pub fn reduced_against_form(
+    cap: &Cap,
+    analysis: &Analysis,
+    schedule: &crate::schedule::Schedule,
+) -> Result<Vec<ReducedAgainstForm>, DesignError> {
+    use rayon::prelude::*;
+    let Some((model, drifts, v)) = prepare(cap)? else {
+        return Ok(Vec::new());
+    };
+    let per_state = state_checks(cap, analysis, schedule, v)?;
+    let time = cap.design.time_model()?;
+    let blf_min = cap.design.constraints.blf_min;
+    let options = &analysis.options;
+    per_state
+        .par_iter()
+        .map(|(index, t_hours, checks)| {
+            let Some(&Check::BucklingTime {
+                blf,
+                s_nu,
+                top,
+                shell0,
+            }) = checks
+                .iter()
+                .find(|c| matches!(c, Check::BucklingTime { .. }))
+            else {
+                return Ok(None);
+            };
+            let state_model = model.drifted(&drifts, *t_hours).map_err(rel_err)?;
+            let fresh = || TimeBuckling {
+                cap,
+                options,
+                schedule,
+                time: time.clone(),
+                vars: v,
+                check: (blf, s_nu, top),
+                blf_min,
+                shell0,
+                last: None,
+                shell: None,
+                solves: Vec::new(),
+            };
+            let mut a = fresh();
+            let reduced = time_form(&state_model, &mut a).map_err(rel_err)?;
+            let mut b = fresh();
+            let full = match form(&state_model, &mut b, &FormOptions::default()) {
+                Ok(r) => Some(r),
                 Err(kappe_reliability::Error::FormNotConverged { beta, .. }) if beta > FAR_BETA => {
-                    Ok(None)
+                    None
                 }
-                Err(e) => Err(rel_err(e)),
-            }
+                Err(e) => return Err(rel_err(e)),
+            };
+            Ok(reduced.zip(full).map(|(r, f)| ReducedAgainstForm {
+                index: *index,
+                beta_reduced: r.beta,
+                solves_reduced: a.solves.len(),
+                beta_form: f.beta,
+                solves_form: b.solves.len(),
+            }))
         })
         .collect::<Result<Vec<_>, DesignError>>()
         .map(|v| v.into_iter().flatten().collect())
@@ -1223,15 +1548,16 @@ pub fn form_checks<'a>(
     t_hours: f64,
     seed: u64,
 ) -> Result<StateForm, kappe_reliability::Error> {
-    form_checks_with(model, checks, Vec::new(), index, t_hours, seed)
+    form_checks_with(model, checks, Vec::new(), false, index, t_hours, seed)
 }
 
-/// [`form_checks`] with `given` components (screened: first-order results) joining the state's
-/// system; the state is flagged `beta_first_order` when there are any.
+/// [`form_checks`] with `given` components (solved already, or screened: first-order results)
+/// joining the state's system; the state is flagged `beta_first_order` when `first_order`.
 fn form_checks_with<'a>(
     model: &Model,
     checks: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)>,
     given: Vec<(&'static str, FormResult)>,
+    first_order: bool,
     index: usize,
     t_hours: f64,
     seed: u64,
@@ -1239,7 +1565,6 @@ fn form_checks_with<'a>(
     let mut by_check = BTreeMap::new();
     let mut own = Vec::new();
     let mut results = Vec::new();
-    let first_order = !given.is_empty();
     for (name, r) in given {
         by_check
             .entry(name.to_owned())
@@ -1366,7 +1691,7 @@ pub fn reliability(
             .fold(0.0_f64, f64::max);
         let n = order.len() as f64;
         for &(i, beta1) in order.iter().skip(1) {
-            let share = n * kappe_reliability::stdnormal::cdf(-(beta1 - SCREEN_DELTA));
+            let share = n * kappe_reliability::stdnormal::cdf(-(beta1 - screen_delta(beta1)));
             if let Some(s) = screened.get_mut(i) {
                 *s = share < SCREEN_SHARE * bound;
             }

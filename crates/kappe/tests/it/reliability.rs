@@ -912,7 +912,7 @@ fn form_of_the_strength_components_agrees_with_monte_carlo() {
 /// P_f moves its picks of a component).
 #[test]
 fn screening_moves_the_print_pf_within_its_bound() {
-    use kappe::analysis::{SCREEN_DELTA, SCREEN_SHARE};
+    use kappe::analysis::{SCREEN_SHARE, screen_delta};
     let mut d = study14(Some(-20.0));
     d.analysis.states = StateSelection::Every(3);
     if let Some(u) = d.uncertainty.as_mut() {
@@ -955,9 +955,10 @@ fn screening_moves_the_print_pf_within_its_bound() {
         let f = full.states.iter().find(|f| f.index == s.index).unwrap();
         let (b1, b) = (s.beta_by_check["buckling"], f.beta_by_check["buckling"]);
         assert!(
-            (b - b1).abs() <= SCREEN_DELTA,
-            "state {}: β₁ {b1} vs FORM {b} (δ {SCREEN_DELTA})",
-            s.index
+            (b - b1).abs() <= screen_delta(b1),
+            "state {}: β₁ {b1} vs FORM {b} (δ {})",
+            s.index,
+            screen_delta(b1)
         );
     }
     assert_eq!(full.components, screened.components);
@@ -980,4 +981,102 @@ fn screening_moves_the_print_pf_within_its_bound() {
         moved <= 2.0 * SCREEN_SHARE,
         "print P_f moved by {moved:.2e} of itself"
     );
+}
+
+/// The 1-D reduction of the time buckling components (docs/reliability.md, "Cost":
+/// λ = E₀·Λ(Ė/E₀), FORM on a Hermite model of ln Λ, the true limit state re-solved only at the
+/// proposed design points) against FORM on the re-solves, on study No. 14's cap with E₀, Ė and
+/// γ uncertain and the mix drying (form_cost's row 1, every third state): every state's β is
+/// FORM's within 10⁻⁵·max(1, β). Both results meet FORM's tolerances (|G| ≤ 10⁻⁶|G₀| and
+/// ‖u − βα‖ ≤ 10⁻⁶‖u‖), so each β lies within about 10⁻⁶(|G₀|/‖∇G‖ + β) ≈ 2·10⁻⁶β of the exact
+/// design point's (|G₀|/‖∇G‖ ≈ β₁ < 1.1β, "Screening"); twice that for the two, with a margin
+/// of 2.5 (measured: 2.5·10⁻⁷ over all 43 states). And the reduction takes fewer re-solves:
+/// at most 5 per state (measured 3–5 with the solve at the means) and less than a third of
+/// FORM's in all (measured 3.7 against 25.7 per state).
+#[test]
+fn reduced_form_of_the_time_buckling_equals_form_on_the_re_solves() {
+    let mut d = study14(Some(-20.0));
+    d.analysis.states = StateSelection::Every(3);
+    if let Some(u) = d.uncertainty.as_mut() {
+        *u = table_of(
+            "\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+             \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+             \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+             [drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+        );
+    }
+    let mut nominal = d.clone();
+    nominal.uncertainty = None;
+    let out = run(&nominal, &Options::of(&nominal), &no_progress).unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let rows = kappe::analysis::reduced_against_form(&cap, analysis, &out.schedule).unwrap();
+    assert!(rows.len() >= 10, "only {} states compared", rows.len());
+    let (mut reduced, mut full, mut worst) = (0, 0, 0.0_f64);
+    for r in &rows {
+        let diff = (r.beta_reduced - r.beta_form).abs() / r.beta_form.abs().max(1.0);
+        assert!(
+            diff <= 1e-5,
+            "state {}: β {} by the reduction vs {} by FORM",
+            r.index,
+            r.beta_reduced,
+            r.beta_form
+        );
+        assert!(
+            r.solves_reduced <= 5,
+            "state {}: {} re-solves",
+            r.index,
+            r.solves_reduced
+        );
+        worst = worst.max(diff);
+        reduced += r.solves_reduced;
+        full += r.solves_form;
+    }
+    eprintln!(
+        "{} states: largest relative β difference {worst:.2e}; re-solves {reduced} reduced vs \
+         {full} FORM",
+        rows.len()
+    );
+    assert!(3 * reduced < full, "{reduced} re-solves vs FORM's {full}");
+}
+
+/// The same comparison on a subset of the default cap's states (`kappe init`'s design with
+/// form_cost's time model and scatter: E(t) = 10 MPa + 1 kPa/s·t, E₀ lognormal cov 0.2, Ė
+/// lognormal cov 0.3, γ normal cov 0.05, E₀ drifting −20 %/h; the states at 50 % of the print
+/// and the last): β within 10⁻⁵·max(1, β) of FORM's on the re-solves, for the reason above
+/// (measured over all 111 states by `form_cost -- 0 3 reduced`: 2.0·10⁻⁸), with fewer re-solves.
+/// Ignored in the quick suite: the default cap's nominal run and FORM on its re-solves take
+/// about 40 s on the shared machine (`cargo test --release -p kappe --test it -- --ignored
+/// reduced_form_equals`).
+#[test]
+#[ignore = "about 40 s: the default cap's run and FORM on its re-solves"]
+fn reduced_form_equals_form_on_default_cap_states() {
+    let d = Design::from_toml_str(
+        "name = \"default\"\n[analysis]\nstates = \"50%\"\n[material.time]\nmodel = \"linear\"\n\
+         youngs_modulus = 1.0e7\nyoungs_modulus_rate = 1000.0\n[uncertainty]\n\
+         \"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.2 }\n\
+         \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+    )
+    .unwrap();
+    let mut nominal = d.clone();
+    nominal.uncertainty = None;
+    let out = run(&nominal, &Options::of(&nominal), &no_progress).unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let rows = kappe::analysis::reduced_against_form(&cap, analysis, &out.schedule).unwrap();
+    assert!(rows.len() >= 2, "only {} states compared", rows.len());
+    let (mut reduced, mut full) = (0, 0);
+    for r in &rows {
+        let diff = (r.beta_reduced - r.beta_form).abs() / r.beta_form.abs().max(1.0);
+        eprintln!(
+            "state {}: β {} reduced ({} re-solves) vs {} FORM ({}): {diff:.1e}",
+            r.index, r.beta_reduced, r.solves_reduced, r.beta_form, r.solves_form
+        );
+        assert!(diff <= 1e-5, "state {}: {r:?}", r.index);
+        reduced += r.solves_reduced;
+        full += r.solves_form;
+    }
+    assert!(reduced < full, "{reduced} re-solves vs FORM's {full}");
 }

@@ -246,3 +246,48 @@ fn uniform_variable_threshold() {
     );
     assert!((r.x_star[0] - 3.0).abs() < 1e-9);
 }
+
+/// `form_at` judges a proposed point with FORM's own tolerances: on a curved limit state
+/// (lognormal R over S, g = R − S: not linear in u) FORM's design point is accepted, with
+/// FORM's β and design point (the same evaluation, so to round-off: 1e-12), and a point off
+/// the surface (the means) or on it but not where u ∥ ∇G is refused; a g_scale that is not
+/// positive and a point of the wrong length are named errors.
+#[test]
+fn form_at_accepts_the_design_point_and_refuses_others() {
+    use kappe_reliability::{Error, form_at};
+    let model = Model::independent(vec![
+        RandomVariable::lognormal_cov("R", 200.0, 0.1).unwrap(),
+        RandomVariable::lognormal_cov("S", 150.0, 0.2).unwrap(),
+    ])
+    .unwrap();
+    let mut g = |x: &[f64]| x[0] - x[1];
+    let o = FormOptions::default();
+    let r = form(&model, &mut g, &o).unwrap();
+    let u0 = model.u_from_x(&model.means());
+    let g0 = (g(&model.x_from_u(&u0))).abs();
+    let at = form_at(&model, &mut g, &r.u_star, g0, &o).unwrap().unwrap();
+    assert!(
+        (at.beta - r.beta).abs() < 1e-12,
+        "{} vs {}",
+        at.beta,
+        r.beta
+    );
+    for (a, b) in at.x_star.iter().zip(&r.x_star) {
+        assert!((a / b - 1.0).abs() < 1e-12);
+    }
+    assert!(form_at(&model, &mut g, &u0, g0, &o).unwrap().is_none());
+    // On the surface R = S but away from the design point: u not parallel to ∇G.
+    let off = model.u_from_x(&[170.0, 170.0]);
+    assert!(form_at(&model, &mut g, &off, g0, &o).unwrap().is_none());
+    assert!(matches!(
+        form_at(&model, &mut g, &r.u_star, 0.0, &o),
+        Err(Error::InvalidOption {
+            field: "g_scale",
+            ..
+        })
+    ));
+    assert!(matches!(
+        form_at(&model, &mut g, &[0.0], g0, &o),
+        Err(Error::DimensionMismatch { .. })
+    ));
+}
