@@ -315,7 +315,14 @@ impl Outcome {
                 // FORM's P_f against the sampled one, with its 95 % interval.
                 row(
                     &mut t,
-                    &format!("Monte Carlo P_f ({:?}, N = {})", mc.method, mc.samples),
+                    &format!(
+                        "Monte Carlo P_f ({}, N = {})",
+                        match mc.method {
+                            crate::input::uncertainty::McMethod::Importance => "importance",
+                            _ => "crude",
+                        },
+                        mc.samples
+                    ),
                     format!(
                         "{:.3e} [{:.3e}, {:.3e}], FORM {:.3e} {}",
                         mc.pf,
