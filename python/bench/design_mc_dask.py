@@ -76,14 +76,15 @@ def main() -> None:
     plan = mc._plan(text, a.samples, a.seed, "auto")
     plan_s = time.perf_counter() - t0
     os.environ["RAYON_NUM_THREADS"] = "1"
+    print(f"plan (the design's run with FORM, this process, all Rayon threads): {plan_s:.1f} s", flush=True)
     rows = []
     for workers in (1, 2):
         with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True) as cluster:
             with distributed.Client(cluster) as client:
                 mc_s, m = run(client, text, plan, a.batches)
                 rows.append((workers, mc_s, m, os.getloadavg()[0]))
+                print(f"{workers} worker(s): {mc_s:.1f} s, P_f {m['pf']!r}", flush=True)
     base = rows[0]
-    print(f"plan (the design's run with FORM, this process, all Rayon threads): {plan_s:.1f} s")
     print(f"{a.samples} samples in {a.batches} batches, one thread per worker, cold (tables in parts, shipped)")
     print(
         "workers | Monte Carlo s (tables + setup + batches) | speed-up | method | P_f | 95 % interval | "

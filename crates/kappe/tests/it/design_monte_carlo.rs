@@ -175,3 +175,49 @@ fn batches_merge_into_the_single_run_bit_for_bit() {
         assert!(merge(&s, &parts[..2]).is_err());
     }
 }
+
+/// A sample the table does not cover is re-solved directly (`TimeBuckling`, FORM's own limit
+/// state): with every table marked `exact` each buckling evaluation re-solves, and the run
+/// counts the re-solves and finds the same failing samples as the tables (their λ differ by
+/// ≤ 1e-5 relative, test above; a sample that close to g = 0 has probability ~1e-4 per
+/// failure here).
+#[test]
+fn samples_outside_the_tables_are_resolved() {
+    let d = cap(
+        3,
+        "\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -30.0 }\n",
+    );
+    let out = run(&d, &Options::of(&d), &no_progress).unwrap();
+    let r = out.reliability.as_ref().unwrap();
+    let analysis = out.analysis.as_ref().unwrap();
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let ctx = McContext::new(&cap, &analysis.options, &out.schedule).unwrap();
+    let p = plan(&ctx, analysis, r, 60, 2, McMethod::Crude).unwrap();
+    let tables = build_tables(&ctx, &p, 0..p.states.len()).unwrap();
+    let exact: Vec<_> = tables
+        .iter()
+        .cloned()
+        .map(|mut t| {
+            t.exact = true;
+            t
+        })
+        .collect();
+    let with_tables = setup(&ctx, p.clone(), tables, 0.0).unwrap();
+    let resolving = setup(&ctx, p, exact, 0.0).unwrap();
+    let a = merge(
+        &with_tables,
+        &[sample_batch(&ctx, &with_tables, Batch { index: 0, count: 1 }).unwrap()],
+    )
+    .unwrap();
+    let b = merge(
+        &resolving,
+        &[sample_batch(&ctx, &resolving, Batch { index: 0, count: 1 }).unwrap()],
+    )
+    .unwrap();
+    eprintln!("tables: {a:?}\nre-solved: {b:?}");
+    assert_eq!(a.resolved_samples, 0);
+    assert!(b.resolved_samples >= 60, "{}", b.resolved_samples);
+    assert!(a.failures > 0 && a.failures < 60, "{}", a.failures);
+    assert_eq!(a.failures, b.failures);
+}
