@@ -8,11 +8,12 @@
 //! cov 0.3, γ normal cov 0.05, E₀ drifting −20 %/h; P_f ≈ 2e-9), importance sampling (crude
 //! sampling of 10⁴ cannot see 2e-9). Per row: FORM's P_f (the run's), the sampled P_f with its
 //! 95 % interval, the governing states, the tables' shell solves, the re-solved samples, and the
-//! seconds of FORM and of the Monte Carlo (tables, centres, samples), with the load average.
+//! seconds of FORM and of the Monte Carlo (tables, centres, samples), the CPU seconds of the
+//! whole run, with the load average.
 
 #[path = "common/measure.rs"]
 mod measure;
-use measure::load_average;
+use measure::{cpu_seconds, load_average};
 
 use kappe::{Design, Options, no_progress, run};
 
@@ -48,7 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rows = std::env::args().nth(2).unwrap_or_else(|| "13".into());
     println!(
         "row | method | N | FORM P_f | MC P_f | 95 % interval | FORM inside | governing states | \
-         excluded share | table solves | re-solved samples | centres | FORM s | MC s | load"
+         excluded share | table solves | re-solved samples | centres | FORM s | MC s | run CPU s | load"
     );
     let mut cases = Vec::new();
     if rows.contains('1') {
@@ -70,11 +71,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     for (name, base, drift, method) in cases {
         let d = design(base, drift, samples, method)?;
+        let c0 = cpu_seconds().unwrap_or(f64::NAN);
         let out = run(&d, &Options::of(&d), &no_progress)?;
+        let cpu = cpu_seconds().unwrap_or(f64::NAN) - c0;
         let r = out.reliability.as_ref().ok_or("no reliability")?;
         let mc = r.monte_carlo.as_ref().ok_or("no Monte Carlo")?;
         println!(
-            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {}",
+            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {}",
             mc.samples,
             r.pf,
             mc.pf,
@@ -89,6 +92,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mc.centers,
             r.seconds,
             mc.seconds,
+            cpu,
             load_average()
         );
     }
