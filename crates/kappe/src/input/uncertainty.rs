@@ -252,7 +252,7 @@ impl UncertaintyTable {
                  \"material.time.youngs_modulus\" and \"material.time.youngs_modulus_rate\"",
             ));
         }
-        self.model_with(&|name: &str| {
+        self.model_of(&|name: &str| {
             if TIME_PARAMETERS.contains(&name) && !time_model {
                 return Err(
                     "a time-model parameter needs a time model: give [material.time] \
@@ -286,6 +286,19 @@ impl UncertaintyTable {
     /// and whether it is positive, or the message of why the name is not allowed (the design's
     /// [`UncertaintyTable::model`] and the buildability spec's share everything else).
     pub fn model_with(&self, lookup: &Lookup<'_>) -> Result<Model, DesignError> {
+        // Only a design chooses its sampler; a buildability spec's Monte Carlo is crude.
+        if self.monte_carlo_method.is_some() {
+            return Err(err(
+                "uncertainty.monte_carlo_method".into(),
+                "a sampling method is a design's key (kappe design); a buildability spec's \
+                 Monte Carlo is crude: remove it",
+            ));
+        }
+        self.model_of(lookup)
+    }
+
+    /// [`UncertaintyTable::model_with`] without the buildability-only checks.
+    fn model_of(&self, lookup: &Lookup<'_>) -> Result<Model, DesignError> {
         if self.parameters.is_empty() {
             return Err(err(
                 "uncertainty".into(),

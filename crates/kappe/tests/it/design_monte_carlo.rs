@@ -221,3 +221,24 @@ fn samples_outside_the_tables_are_resolved() {
     assert!(a.failures > 0 && a.failures < 60, "{}", a.failures);
     assert_eq!(a.failures, b.failures);
 }
+
+/// A sampling method without a sample count (a design), or in a buildability spec's table
+/// (whose Monte Carlo is crude), is a named error.
+#[test]
+fn a_method_without_samples_or_outside_a_design_is_a_named_error() {
+    let e = Design::from_toml_str(
+        "name = \"m\"\n[material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\n\
+         youngs_modulus_rate = 400.0\n[uncertainty]\n\
+         \"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         monte_carlo_method = \"importance\"\n",
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("monte_carlo_method"), "{e}");
+    let table: kappe::input::UncertaintyTable = toml::from_str(
+        "\"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+         monte_carlo = 1000\nmonte_carlo_method = \"crude\"\n",
+    )
+    .unwrap();
+    let e = table.model_with(&|_: &str| Ok((2.0e4, false))).unwrap_err();
+    assert!(e.to_string().contains("monte_carlo_method"), "{e}");
+}
