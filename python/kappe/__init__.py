@@ -36,6 +36,7 @@ __all__ = [
     "OptimizeResult",
     "study",
     "buildability_monte_carlo",
+    "design_monte_carlo",
     "ceiling",
     "CeilingResult",
     "cem",
@@ -454,5 +455,6 @@ def design(
 from . import cem, fe, robot  # noqa: E402  (submodules use the names above)
 from ._buildability import buildability_monte_carlo  # noqa: E402
 from ._ceiling import CeilingResult, ceiling  # noqa: E402
+from ._design_mc import design_monte_carlo  # noqa: E402
 from ._optimize import OptimizeResult, optimize  # noqa: E402
 from ._study import study  # noqa: E402

@@ -8,6 +8,7 @@ from . import robot as robot
 from ._buildability import buildability_monte_carlo as buildability_monte_carlo
 from ._ceiling import CeilingResult as CeilingResult
 from ._ceiling import ceiling as ceiling
+from ._design_mc import design_monte_carlo as design_monte_carlo
 from ._optimize import OptimizeResult as OptimizeResult
 from ._optimize import optimize as optimize
 from ._study import study as study

@@ -281,10 +281,15 @@ fn after_form(
     };
     check(stop)?;
     // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.
-    let reliability = match &analysis {
+    let mut reliability = match &analysis {
         Some(a) => crate::analysis::reliability::reliability(&cap, a, &schedule)?,
         None => None,
     };
+    // `[uncertainty] monte_carlo = N`: the print's governing states sampled (issue 24).
+    if let (Some(r), Some(a)) = (reliability.as_mut(), &analysis) {
+        r.monte_carlo =
+            crate::analysis::design_monte_carlo::design_monte_carlo(&cap, a, &schedule, r)?;
+    }
     check(stop)?;
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.

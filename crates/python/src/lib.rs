@@ -13,7 +13,7 @@
 //!
 //! One module per area, as the package's Python modules: [`design`], [`study`], [`ceiling`],
 //! [`cem`], [`fe`], [`optimize`], [`robot`], [`buildability`] (the Monte Carlo batches of a
-//! buildability print); [`errors`] maps library errors to Python exceptions.
+//! buildability print), [`design_mc`] (the steps of a design's Monte Carlo); [`errors`] maps library errors to Python exceptions.
 
 use pyo3::prelude::*;
 
@@ -21,6 +21,7 @@ mod buildability;
 mod ceiling;
 mod cem;
 mod design;
+mod design_mc;
 mod errors;
 mod fe;
 mod optimize;
@@ -71,5 +72,10 @@ fn _kappe(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_batch, m)?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_merge, m)?)?;
+    m.add_function(wrap_pyfunction!(design_mc::design_mc_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(design_mc::design_mc_table_part, m)?)?;
+    m.add_function(wrap_pyfunction!(design_mc::design_mc_setup, m)?)?;
+    m.add_function(wrap_pyfunction!(design_mc::design_mc_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(design_mc::design_mc_merge, m)?)?;
     Ok(())
 }

@@ -162,3 +162,55 @@ fn buildability_bad_uncertainty_writes_nothing() {
         assert!(!dir.path().join("out").exists(), "{extra}: out written");
     }
 }
+
+/// `kappe design` with `[uncertainty] monte_carlo`: summary.json's `reliability.monte_carlo`
+/// has the sampled P_f with its interval next to FORM's, and the terminal prints one line with
+/// both. Study No. 14's cap, every third state, E₀ and γ uncertain, drifting −12 %/h (P_f ≈
+/// 2e-2); a method without a sample count is a named error and writes nothing.
+#[test]
+fn design_monte_carlo_writes_its_block_and_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = "[cap]\nlength = 0.15\n[print]\npath_sampling = 0.04\nprint_speed = 0.01\n\
+         [robot]\nenabled = false\n[analysis]\nrow_stride = 8\nstates = \"every:3\"\n\
+         [material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
+         [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n";
+    let drift =
+        "[uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -12.0 }\n";
+    std::fs::write(
+        dir.path().join("cap.toml"),
+        format!("{base}monte_carlo = 2000\nmonte_carlo_method = \"crude\"\nseed = 3\n{drift}"),
+    )
+    .unwrap();
+    let o = kappe(
+        dir.path(),
+        &["design", "cap.toml", "--out", "out", "--allow-fail"],
+    );
+    let stdout = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(0), "{stdout}\n{}", text(&o.stderr));
+    assert!(
+        stdout.contains("Monte Carlo P_f (crude, N = 2000)"),
+        "{stdout}"
+    );
+    let doc: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(dir.path().join("out").join("summary.json")).unwrap(),
+    )
+    .unwrap();
+    let mc = &doc["reliability"]["monte_carlo"];
+    assert_eq!(mc["samples"], 2000);
+    let pf = mc["pf"].as_f64().unwrap();
+    let [lo, hi] = [0, 1].map(|i| mc["pf_interval"][i].as_f64().unwrap());
+    assert!(lo <= pf && pf <= hi && pf > 0.0, "{mc}");
+    assert_eq!(mc["form_pf"], doc["reliability"]["pf"]);
+
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        format!("{base}monte_carlo_method = \"crude\"\n{drift}"),
+    )
+    .unwrap();
+    let o = kappe(dir.path(), &["design", "bad.toml", "--out", "bad"]);
+    let err = text(&o.stderr);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(err.contains("uncertainty.monte_carlo_method"), "{err}");
+    assert!(!dir.path().join("bad").exists());
+}

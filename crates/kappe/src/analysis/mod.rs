@@ -38,6 +38,7 @@ pub(crate) mod buckling;
 pub(crate) mod check;
 pub(crate) mod collapse;
 pub(crate) mod convergence;
+pub mod design_monte_carlo;
 pub(crate) mod graded;
 pub(crate) mod green;
 pub(crate) mod reliability;

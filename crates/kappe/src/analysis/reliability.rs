@@ -155,6 +155,10 @@ pub struct Reliability {
     pub components: usize,
     /// Wall-clock seconds of the reliability analysis (re-solves included).
     pub seconds: f64,
+    /// The Monte Carlo of the print's governing states (`[uncertainty] monte_carlo`; absent
+    /// without it): `crate::analysis::design_monte_carlo`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monte_carlo: Option<super::design_monte_carlo::DesignMonteCarlo>,
 }
 
 /// What a check of one state depends on; see the module docs.
@@ -445,8 +449,6 @@ impl TimeBuckling<'_> {
 
     fn eval(&mut self, x: &[f64], grad: &mut [f64]) -> Result<f64, kappe_reliability::EvalError> {
         let v = self.vars;
-        let at =
-            |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
         let shell0 = match self.shell0 {
             Some(l) => l,
             None => {
@@ -455,29 +457,52 @@ impl TimeBuckling<'_> {
                 l
             }
         };
-        let (blf, s_nu, _) = self.check;
-        let (l, dl) = self.solve(Some(x))?;
-        let gamma = at(v.gamma, v.gamma0);
-        let rg = gamma / v.gamma0;
-        let nu = at(v.nu, v.nu0);
-        let lin = 1.0 + s_nu * (nu - v.nu0);
-        let k = blf / shell0;
-        let val = k * l / rg * lin;
-        grad.iter_mut().for_each(|g| *g = 0.0);
-        let mut set = |i: Option<usize>, d: f64| {
-            if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
-                *g = d;
-            }
-        };
-        set(v.e0t, k * dl[0] / rg * lin);
-        set(v.rate, k * dl[1] / rg * lin);
-        // s = v₀/v: ∂s/∂v = −s/v.
-        let speed = at(v.speed, v.speed0);
-        set(v.speed, -k * dl[2] * (v.speed0 / speed) / speed / rg * lin);
-        set(v.gamma, -val / gamma);
-        set(v.nu, k * l / rg * s_nu);
-        Ok(val - self.blf_min)
+        let solved = self.solve(Some(x))?;
+        Ok(time_buckling_g(
+            (self.check.0, self.check.1),
+            shell0,
+            self.blf_min,
+            v,
+            x,
+            solved,
+            grad,
+        ))
     }
+}
+
+/// g of [`TimeBuckling`] at `x` from λ and (∂λ/∂E₀, ∂λ/∂Ė, ∂λ/∂s) at `x` (a re-solve, or the
+/// design Monte Carlo's table, `crate::analysis::design_monte_carlo`), BLF₀ and s_ν in `check`,
+/// λ at the design's values `shell0`; `grad` (any length, empty for none) gets ∂g/∂x.
+pub fn time_buckling_g(
+    (blf, s_nu): (f64, f64),
+    shell0: f64,
+    blf_min: f64,
+    v: Vars,
+    x: &[f64],
+    (l, dl): (f64, [f64; 3]),
+    grad: &mut [f64],
+) -> f64 {
+    let at = |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+    let gamma = at(v.gamma, v.gamma0);
+    let rg = gamma / v.gamma0;
+    let nu = at(v.nu, v.nu0);
+    let lin = 1.0 + s_nu * (nu - v.nu0);
+    let k = blf / shell0;
+    let val = k * l / rg * lin;
+    grad.iter_mut().for_each(|g| *g = 0.0);
+    let mut set = |i: Option<usize>, d: f64| {
+        if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+            *g = d;
+        }
+    };
+    set(v.e0t, k * dl[0] / rg * lin);
+    set(v.rate, k * dl[1] / rg * lin);
+    // s = v₀/v: ∂s/∂v = −s/v.
+    let speed = at(v.speed, v.speed0);
+    set(v.speed, -k * dl[2] * (v.speed0 / speed) / speed / rg * lin);
+    set(v.gamma, -val / gamma);
+    set(v.nu, k * l / rg * s_nu);
+    val - blf_min
 }
 
 /// The ages of layers 0..=`top` at the state with top print index `top` when every print
@@ -737,7 +762,7 @@ fn time_form(
 }
 
 /// The checks of every state that a random variable enters, with the state's print time (h).
-fn state_checks(
+pub(crate) fn state_checks(
     cap: &Cap,
     analysis: &Analysis,
     schedule: &crate::schedule::Schedule,
@@ -1802,5 +1827,6 @@ pub fn print_reliability(
         states,
         components: components.len(),
         seconds: t0.elapsed().as_secs_f64(),
+        monte_carlo: None,
     })
 }

@@ -74,6 +74,21 @@ pub const SPEED: &str = "print.print_speed";
 /// A parameter's nominal value and whether it is positive, or why its name is not allowed.
 pub type Lookup<'a> = dyn Fn(&str) -> Result<(f64, bool), String> + 'a;
 
+/// The estimator of a design's Monte Carlo (`[uncertainty] monte_carlo_method`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema, Default,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum McMethod {
+    /// Crude when the expected failures N·P_f,FORM reach 100 (P̂'s cov ≤ 0.1), else importance.
+    #[default]
+    Auto,
+    /// Crude Monte Carlo: u ~ N(0, I).
+    Crude,
+    /// Importance sampling from the mixture of N(u*_i, I) over the components' design points.
+    Importance,
+}
+
 /// The `[uncertainty]` table; see the module docs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UncertaintyTable {
@@ -89,9 +104,13 @@ pub struct UncertaintyTable {
     /// Seed of the series system's sampler (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
-    /// Crude Monte Carlo samples of the whole print (`kappe buildability` only).
+    /// Monte Carlo samples of the whole print: crude in `kappe buildability`; a design's
+    /// governing states, crude or by importance sampling (`crate::analysis::design_monte_carlo`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub monte_carlo: Option<u64>,
+    /// A design's sampling method: `auto` (default), `crude` or `importance`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monte_carlo_method: Option<McMethod>,
     /// The first-order screening of the states' buckling components (default true; false runs
     /// FORM on every state, see `crate::analysis::reliability`, "Screening").
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -218,11 +237,10 @@ impl UncertaintyTable {
                 ),
             ));
         }
-        if self.monte_carlo.is_some() {
+        if self.monte_carlo_method.is_some() && self.monte_carlo.is_none() {
             return Err(err(
-                "uncertainty.monte_carlo".into(),
-                "a Monte Carlo of the whole print is for buildability specs (kappe \
-                 buildability); a design's states are checked by FORM",
+                "uncertainty.monte_carlo_method".into(),
+                "a sampling method needs a sample count: give monte_carlo = N (≥ 100)",
             ));
         }
         let time_model = design.material.time.is_some() || design.analysis.ageing.is_some();
@@ -234,7 +252,7 @@ impl UncertaintyTable {
                  \"material.time.youngs_modulus\" and \"material.time.youngs_modulus_rate\"",
             ));
         }
-        self.model_with(&|name: &str| {
+        self.model_of(&|name: &str| {
             if TIME_PARAMETERS.contains(&name) && !time_model {
                 return Err(
                     "a time-model parameter needs a time model: give [material.time] \
@@ -268,6 +286,19 @@ impl UncertaintyTable {
     /// and whether it is positive, or the message of why the name is not allowed (the design's
     /// [`UncertaintyTable::model`] and the buildability spec's share everything else).
     pub fn model_with(&self, lookup: &Lookup<'_>) -> Result<Model, DesignError> {
+        // Only a design chooses its sampler; a buildability spec's Monte Carlo is crude.
+        if self.monte_carlo_method.is_some() {
+            return Err(err(
+                "uncertainty.monte_carlo_method".into(),
+                "a sampling method is a design's key (kappe design); a buildability spec's \
+                 Monte Carlo is crude: remove it",
+            ));
+        }
+        self.model_of(lookup)
+    }
+
+    /// [`UncertaintyTable::model_with`] without the buildability-only checks.
+    fn model_of(&self, lookup: &Lookup<'_>) -> Result<Model, DesignError> {
         if self.parameters.is_empty() {
             return Err(err(
                 "uncertainty".into(),

@@ -311,6 +311,32 @@ impl Outcome {
                 &format!("reliability β (min {:.2}) / P_f", r.beta_min),
                 format!("{:.2} / {:.2e}", r.beta, r.pf),
             );
+            if let Some(mc) = &r.monte_carlo {
+                // FORM's P_f against the sampled one, with its 95 % interval.
+                row(
+                    &mut t,
+                    &format!(
+                        "Monte Carlo P_f ({}, N = {})",
+                        match mc.method {
+                            crate::input::uncertainty::McMethod::Importance => "importance",
+                            _ => "crude",
+                        },
+                        mc.samples
+                    ),
+                    format!(
+                        "{:.3e} [{:.3e}, {:.3e}], FORM {:.3e} {}",
+                        mc.pf,
+                        mc.pf_interval[0],
+                        mc.pf_interval[1],
+                        mc.form_pf,
+                        if mc.form_in_interval {
+                            "inside"
+                        } else {
+                            "outside"
+                        }
+                    ),
+                );
+            }
         }
         let _ = writeln!(
             t,

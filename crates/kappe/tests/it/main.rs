@@ -11,6 +11,7 @@ mod ceiling;
 mod collapse;
 mod common;
 mod corrugation;
+mod design_monte_carlo;
 mod ends;
 mod floors;
 mod green_state;
