@@ -27,8 +27,8 @@ use rand_chacha::rand_core::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 
 use super::reliability::{
-    Check, FAR_BETA, GreenField, RESOLVE_TOLERANCE, Reliability, SCREEN_DELTA, TimeBuckling, Vars,
-    limit_state, scaled_ages, state_checks, time_buckling_g,
+    Check, FAR_BETA, GreenField, RESOLVE_TOLERANCE, Reliability, TimeBuckling, Vars, limit_state,
+    scaled_ages, screen_delta, state_checks, time_buckling_g,
 };
 use super::{AnalysisOptions, check::Analysis};
 use crate::form::cap::Cap;
@@ -45,7 +45,7 @@ pub const GOVERNING_SHARE: f64 = 1e-2;
 /// Δ_q of a state whose β is FORM's: FORM's first-order error measured against Monte Carlo on
 /// study No. 14's last state with E₀ and Ė uncertain (0.128 against 0.113: Δβ ≈ 0.07,
 /// docs/reliability.md, Limits) times a safety factor of about 7. A screened state (first-order
-/// β₁, `beta_first_order`) takes the screening rule's δ, [`SCREEN_DELTA`].
+/// β₁, `beta_first_order`) takes the screening rule's δ(β₁), [`screen_delta`].
 pub const GOVERNING_DELTA: f64 = 0.5;
 
 /// Chebyshev points of ln ρ (ρ = Ė/E₀) per state: ln Λ is smooth in ln ρ (from the uniform
@@ -379,7 +379,7 @@ pub fn plan(
         .iter()
         .map(|s| {
             let delta = if s.beta_first_order {
-                SCREEN_DELTA
+                screen_delta(s.beta)
             } else {
                 GOVERNING_DELTA
             };
@@ -709,6 +709,7 @@ impl LimitState for TableBuckling<'_> {
                 shell0: Some(shell0),
                 last: None,
                 shell: None,
+                solves: Vec::new(),
             })
         });
         g.value(x)
