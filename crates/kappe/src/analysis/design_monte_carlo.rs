@@ -434,8 +434,9 @@ pub fn plan(
 }
 
 /// Chebyshev points of the first kind on [lo, hi] and their barycentric weights (Berrut &
-/// Trefethen 2004, (5.3)); one point (lo) when k = 1 or lo = hi.
-fn cheb(lo: f64, hi: f64, k: usize) -> (Vec<f64>, Vec<f64>) {
+/// Trefethen 2004, (5.3)); one point (lo) when k = 1 or lo = hi. The design's and the
+/// buildability objects' tables both use it.
+pub(crate) fn cheb(lo: f64, hi: f64, k: usize) -> (Vec<f64>, Vec<f64>) {
     if k <= 1 || lo == hi {
         return (vec![lo], vec![1.0]);
     }
@@ -445,17 +446,21 @@ fn cheb(lo: f64, hi: f64, k: usize) -> (Vec<f64>, Vec<f64>) {
         .map(|j| 0.5 * (lo + hi) + 0.5 * (hi - lo) * th(j).cos())
         .collect();
     let weights = (0..k)
-        .map(|j| if j % 2 == 0 { 1.0 } else { -1.0 } * th(j).sin())
+        .map(|j| {
+            let sign = if j % 2 == 0 { 1.0 } else { -1.0 };
+            sign * th(j).sin()
+        })
         .collect();
     (nodes, weights)
 }
 
-/// The barycentric coefficients c_j at s: f(s) = Σ c_j f_j.
-fn bary(nodes: &[f64], weights: &[f64], s: f64) -> Vec<f64> {
-    let mut out = vec![0.0; nodes.len()];
+/// The barycentric coefficients c_j of the interpolant at s, f(s) = Σ c_j f_j, into `out`
+/// (as long as `nodes`).
+pub(crate) fn bary_into(nodes: &[f64], weights: &[f64], s: f64, out: &mut [f64]) {
     if let Some(j) = nodes.iter().position(|&x| x == s) {
+        out.iter_mut().for_each(|c| *c = 0.0);
         out[j] = 1.0;
-        return out;
+        return;
     }
     let mut sum = 0.0;
     for ((c, &x), &w) in out.iter_mut().zip(nodes).zip(weights) {
@@ -463,6 +468,12 @@ fn bary(nodes: &[f64], weights: &[f64], s: f64) -> Vec<f64> {
         sum += *c;
     }
     out.iter_mut().for_each(|c| *c /= sum);
+}
+
+/// [`bary_into`] into a new vector.
+fn bary(nodes: &[f64], weights: &[f64], s: f64) -> Vec<f64> {
+    let mut out = vec![0.0; nodes.len()];
+    bary_into(nodes, weights, s, &mut out);
     out
 }
 

@@ -43,6 +43,7 @@ use kappe_reliability::{
     merge_events, sample_events,
 };
 
+use crate::analysis::design_monte_carlo::{bary_into, cheb};
 use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
 use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
@@ -250,40 +251,6 @@ pub type StateValues = (Option<f64>, Option<f64>, Option<f64>);
 pub fn exact_state(r: &Resolved, n: usize, p: &[f64; 6]) -> Result<StateValues, DesignError> {
     let s = check_layers(&resolved_at(r, p)?, n)?;
     Ok((s.blf, s.strength_utilisation, s.sliding_utilisation))
-}
-
-/// Barycentric weights of the Chebyshev points of the first kind (Berrut & Trefethen 2004, (5.3)).
-fn cheb(lo: f64, hi: f64, k: usize) -> (Vec<f64>, Vec<f64>) {
-    let pi = std::f64::consts::PI;
-    let nodes = (0..k)
-        .map(|j| {
-            let t = ((2 * j + 1) as f64 * pi / (2 * k) as f64).cos();
-            0.5 * (lo + hi) + 0.5 * (hi - lo) * t
-        })
-        .collect();
-    let weights = (0..k)
-        .map(|j| {
-            let th = (2 * j + 1) as f64 * pi / (2 * k) as f64;
-            let s = if j % 2 == 0 { 1.0 } else { -1.0 };
-            s * th.sin()
-        })
-        .collect();
-    (nodes, weights)
-}
-
-/// Coefficients c_j of the interpolant at s: f(s) = Σ c_j f_j.
-fn bary(nodes: &[f64], weights: &[f64], s: f64, out: &mut [f64]) {
-    if let Some(j) = nodes.iter().position(|&x| x == s) {
-        out.iter_mut().for_each(|c| *c = 0.0);
-        out[j] = 1.0;
-        return;
-    }
-    let mut sum = 0.0;
-    for ((c, &x), &w) in out.iter_mut().zip(nodes).zip(weights) {
-        *c = w / (s - x);
-        sum += *c;
-    }
-    out.iter_mut().for_each(|c| *c /= sum);
 }
 
 /// One layer count's tables at the interpolation points.
@@ -719,8 +686,8 @@ impl Surrogate {
                 };
                 let mut ce = [0.0; NODES];
                 let mut ci = [0.0; NODES];
-                bary(&self.nodes, &self.weights, e, &mut ce[..k]);
-                bary(&self.nodes, &self.weights, inner, &mut ci[..k]);
+                bary_into(&self.nodes, &self.weights, e, &mut ce[..k]);
+                bary_into(&self.nodes, &self.weights, inner, &mut ci[..k]);
                 let t = (s - e) / (e - inner);
                 for j in 0..k {
                     coef[j] = ce[j] + (ce[j] - ci[j]) * t;
@@ -730,7 +697,7 @@ impl Surrogate {
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 return exact_state(r, n, p);
             } else {
-                bary(&self.nodes, &self.weights, s, coef);
+                bary_into(&self.nodes, &self.weights, s, coef);
             }
         }
         let at = |v: &[f64], stride: usize, i: usize| -> f64 {
