@@ -10,6 +10,9 @@
 //! violation first, then less material (the printed volume lw·lh·path length). Infeasible
 //! designs (form-finding fails, a parameter outside its physical range) count as violating.
 //!
+//! With `[uncertainty]` the print's β counts like a constraint: β < `beta_min` adds its relative
+//! shortfall (β_min − β)/β_min to the violation, so the search moves towards reliable designs.
+//!
 //! The loop analyses buckling on a thinned state selection (`[analysis]` of the file, default
 //! every 25 % of progress, which always includes the final state); the result is verified with
 //! the final analysis options (default: every state) and the verdict reported.
@@ -375,8 +378,20 @@ fn evaluate(d: &Design, options: &AnalysisOptions) -> Evaluated {
         Ok(out) => {
             let mut v = out.analysis.as_ref().map(violations).unwrap_or_default();
             for f in &out.verdict.failures {
-                if !matches!(f, crate::verdict::Failure::Constraint { .. }) {
-                    v.push((f.to_string(), ROBOT_FAILURE));
+                match f {
+                    // The print's reliability (issue 24): not an analysis constraint, so graded
+                    // here by its relative shortfall, as `blf_min` is.
+                    crate::verdict::Failure::Constraint {
+                        name,
+                        worst: Some(beta),
+                        limit,
+                        ..
+                    } if name == "beta_min" => {
+                        let shortfall = (limit - beta) / limit.abs().max(1e-12);
+                        v.push((name.clone(), shortfall.max(1e-6)));
+                    }
+                    crate::verdict::Failure::Constraint { .. } => {}
+                    _ => v.push((f.to_string(), ROBOT_FAILURE)),
                 }
             }
             // `+ 0.0` turns the −0.0 of an empty sum into 0.

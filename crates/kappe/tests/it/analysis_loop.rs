@@ -219,3 +219,49 @@ fn infeasible_request_names_the_binding_constraint() {
         r.binding
     );
 }
+
+/// `beta_min` steers the loop (issue 24): with E uncertain the print's β grows with the BLF, and a
+/// target (7.9, near the largest allowed) that no layer width in the bounds reaches with E this
+/// scattered (cov 1.5) leaves every evaluation failing on `beta_min`,
+/// graded by its shortfall (β_min − β)/β_min — so the thicker (more reliable) walls violate less —
+/// and the result infeasible with `beta_min` named.
+#[test]
+fn optimize_counts_the_print_reliability() {
+    let mut d = Design::from_toml_str(
+        "name = \"u\"\n[constraints]\nbeta_min = 7.9\n\
+         [uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 1.5 }\n",
+    )
+    .unwrap();
+    d.cap.length = 0.1;
+    d.print.path_sampling = 0.04;
+    d.robot.enabled = false;
+    // Thin walls overhang more than lw/2 (`loop_finds_the_least_material_within_bounds`): a loose
+    // overhang limit leaves β the only failing check.
+    d.constraints.overhang_max = Some(0.1);
+    let text = "max_evaluations = 3\n\
+                [analysis]\nstates = \"every:100000\"\nrow_stride = 8\n\
+                [verify]\nstates = \"every:100000\"\nrow_stride = 8\n\
+                [free]\n\"print.layer_width\" = { min = 0.015, max = 0.03 }\n";
+    let f = OptimizeFile::from_toml_str(text).unwrap();
+    let r = optimize(&f, &d, &|_| std::ops::ControlFlow::Continue(())).unwrap();
+    assert!(!r.feasible);
+    assert!(r.binding.iter().any(|b| b == "beta_min"), "{:?}", r.binding);
+    assert!(r.evaluations.len() >= 2);
+    for e in &r.evaluations {
+        assert!(e.failing.iter().any(|f| f == "beta_min"), "{e:?}");
+        // β ≥ 0 here, so the shortfall is at most 1; it is more than the 1e-6 floor.
+        assert!(e.violation > 1e-3 && e.violation <= 1.0 + 1e-9, "{e:?}");
+    }
+    // BLF grows about with lw² (`analysis_props`), so β grows with lw and the shortfall falls.
+    for a in &r.evaluations {
+        for b in &r.evaluations {
+            let (wa, wb) = (
+                a.parameters["print.layer_width"],
+                b.parameters["print.layer_width"],
+            );
+            if wa > wb + 1e-9 {
+                assert!(a.violation < b.violation, "{a:?} vs {b:?}");
+            }
+        }
+    }
+}
