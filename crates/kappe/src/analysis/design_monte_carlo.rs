@@ -709,19 +709,14 @@ impl LimitState for TableBuckling<'_> {
         let ctx = self.ctx;
         let shell0 = self.table.shell0;
         let g = self.exact.get_or_insert_with(|| {
-            Box::new(TimeBuckling {
-                cap: ctx.cap,
-                options: ctx.options,
-                schedule: ctx.schedule,
-                time: time.clone(),
-                vars: v,
-                check: (blf, s_nu, top),
+            Box::new(TimeBuckling::new(
+                (ctx.cap, ctx.options, ctx.schedule),
+                time.clone(),
+                v,
+                (blf, s_nu, top),
                 blf_min,
-                shell0: Some(shell0),
-                last: None,
-                shell: None,
-                solves: Vec::new(),
-            })
+                Some(shell0),
+            ))
         });
         g.value(x)
     }
@@ -1095,8 +1090,9 @@ pub fn design_monte_carlo(
     merge(&setup, &[batch]).map(Some)
 }
 
-/// Numbers as their bit patterns (JSON has no NaN, and the bits round-trip exactly).
-mod bits {
+/// Numbers as their bit patterns (JSON has no NaN, and the bits round-trip exactly); the
+/// design's and the buildability objects' shipped tables both use it.
+pub(crate) mod bits {
     use serde::{Deserialize, Deserializer, Serializer};
 
     pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
@@ -1120,6 +1116,23 @@ mod bits {
 
         pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
             Ok(f64::from_bits(u64::deserialize(d)?))
+        }
+    }
+
+    /// The same for `Option<Vec<f64>>`.
+    pub mod option {
+        use serde::{Deserialize, Deserializer, Serializer};
+
+        pub fn serialize<S: Serializer>(v: &Option<Vec<f64>>, s: S) -> Result<S::Ok, S::Error> {
+            match v {
+                Some(v) => s.serialize_some(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()),
+                None => s.serialize_none(),
+            }
+        }
+
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<f64>>, D::Error> {
+            Ok(Option::<Vec<u64>>::deserialize(d)?
+                .map(|v| v.into_iter().map(f64::from_bits).collect()))
         }
     }
 }

@@ -399,6 +399,39 @@ pub struct TimeBuckling<'a> {
     pub solves: Vec<[f64; 4]>,
 }
 
+impl<'a> TimeBuckling<'a> {
+    /// A state's limit state before its first solve: `run` is the cap, the analysis options and
+    /// the schedule; `check` is the state's (BLF₀, s_ν, top layer) and `shell0` its print-layer
+    /// factor. The one place that knows the fields kept between re-solves start empty.
+    pub fn new(
+        run: (
+            &'a Cap,
+            &'a super::AnalysisOptions,
+            &'a crate::schedule::Schedule,
+        ),
+        time: crate::input::material::TimeModel,
+        vars: Vars,
+        check: (f64, f64, usize),
+        blf_min: f64,
+        shell0: Option<f64>,
+    ) -> Self {
+        let (cap, options, schedule) = run;
+        TimeBuckling {
+            cap,
+            options,
+            schedule,
+            time,
+            vars,
+            check,
+            blf_min,
+            shell0,
+            last: None,
+            shell: None,
+            solves: Vec::new(),
+        }
+    }
+}
+
 /// Lanczos relative residual of the re-solves: the eigenvalue error is of the order of its
 /// square (symmetric pencil), far below FORM's tolerance on g (1e-6 relative).
 pub const RESOLVE_TOLERANCE: f64 = 1e-8;
@@ -1251,19 +1284,14 @@ fn state_form_with<'a>(
                 },
                 None,
                 Some(time),
-            ) => Some(Box::new(TimeBuckling {
-                cap,
-                options,
-                schedule,
-                time: time.clone(),
-                vars: v,
-                check: (blf, s_nu, top),
-                blf_min: k.blf_min,
+            ) => Some(Box::new(TimeBuckling::new(
+                (cap, options, schedule),
+                time.clone(),
+                v,
+                (blf, s_nu, top),
+                k.blf_min,
                 shell0,
-                last: None,
-                shell: None,
-                solves: Vec::new(),
-            })),
+            ))),
             _ => None,
         };
         if let Some(mut g) = time_buckling {
@@ -1399,19 +1427,14 @@ fn first_orders<'a>(
                         field: "uncertainty.drift".into(),
                         message: format!("state {index} at {t_hours:.3} h: {e}"),
                     })?;
-            let mut g = Box::new(TimeBuckling {
-                cap,
-                options,
-                schedule,
-                time: time.clone(),
-                vars: v,
-                check: (blf, s_nu, top),
+            let mut g = Box::new(TimeBuckling::new(
+                (cap, options, schedule),
+                time.clone(),
+                v,
+                (blf, s_nu, top),
                 blf_min,
                 shell0,
-                last: None,
-                shell: None,
-                solves: Vec::new(),
-            });
+            ));
             let r = first_order(&state_model, &mut g).map_err(|e| DesignError::Uncertainty {
                 field: "uncertainty".into(),
                 message: format!("reliability analysis, state {index}: {e}"),
@@ -1524,18 +1547,15 @@ pub fn reduced_against_form(
                 return Ok(None);
             };
             let state_model = model.drifted(&drifts, *t_hours).map_err(rel_err)?;
-            let fresh = || TimeBuckling {
-                cap,
-                options,
-                schedule,
-                time: time.clone(),
-                vars: v,
-                check: (blf, s_nu, top),
-                blf_min,
-                shell0,
-                last: None,
-                shell: None,
-                solves: Vec::new(),
+            let fresh = || {
+                TimeBuckling::new(
+                    (cap, options, schedule),
+                    time.clone(),
+                    v,
+                    (blf, s_nu, top),
+                    blf_min,
+                    shell0,
+                )
             };
             let mut a = fresh();
             let reduced = time_form(&state_model, &mut a).map_err(rel_err)?;

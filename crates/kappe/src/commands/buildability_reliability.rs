@@ -43,7 +43,7 @@ use kappe_reliability::{
     merge_events, sample_events,
 };
 
-use crate::analysis::design_monte_carlo::{bary_into, cheb};
+use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
 use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
 use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
@@ -395,39 +395,6 @@ impl SurrogateTables {
             all.build_seconds += p.build_seconds;
         }
         Ok(all)
-    }
-}
-
-/// `Vec<f64>` as the `u64` bit patterns of its values (see [`SurrogateTables`]).
-mod bits {
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    pub fn serialize<S: Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(v.iter().map(|x| x.to_bits()))
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
-        Ok(Vec::<u64>::deserialize(d)?
-            .into_iter()
-            .map(f64::from_bits)
-            .collect())
-    }
-
-    /// The same for `Option<Vec<f64>>`.
-    pub mod option {
-        use serde::{Deserialize, Deserializer, Serializer};
-
-        pub fn serialize<S: Serializer>(v: &Option<Vec<f64>>, s: S) -> Result<S::Ok, S::Error> {
-            match v {
-                Some(v) => s.serialize_some(&v.iter().map(|x| x.to_bits()).collect::<Vec<_>>()),
-                None => s.serialize_none(),
-            }
-        }
-
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<f64>>, D::Error> {
-            Ok(Option::<Vec<u64>>::deserialize(d)?
-                .map(|v| v.into_iter().map(f64::from_bits).collect()))
-        }
     }
 }
 
