@@ -534,6 +534,10 @@ pub struct Buildability {
     /// The print's crude Monte Carlo (with `[uncertainty] monte_carlo = N`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub monte_carlo: Option<crate::commands::buildability_reliability::PrintMonteCarlo>,
+    /// The collapse limit state's tables and their check at the design points (with
+    /// `[analysis.nonlinear]` and `[uncertainty]`; docs/reliability.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collapse_reliability: Option<crate::commands::buildability_collapse::CollapseReliability>,
 }
 
 /// The `n`-layer object of `r` with every element's modulus at its layer's age (the model
@@ -757,9 +761,10 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
         states.extend(part);
         next = hi + 1;
     }
-    let (reliability, monte_carlo) = match &r.spec.uncertainty {
+    let (reliability, monte_carlo, collapse_reliability) = match &r.spec.uncertainty {
         Some(table) => {
-            let (rel, mc) = crate::commands::buildability_reliability::analyse(r, table, &states)?;
+            let (rel, mc, col) =
+                crate::commands::buildability_reliability::analyse(r, table, &states)?;
             for s in &mut states {
                 if let Some(x) = rel.states.iter().find(|x| x.index == s.layers) {
                     s.beta = Some(x.beta);
@@ -767,9 +772,9 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
                     s.beta_by_check = Some(x.beta_by_check.clone());
                 }
             }
-            (Some(rel), mc)
+            (Some(rel), mc, col)
         }
-        None => (None, None),
+        None => (None, None, None),
     };
     let first_fail = states.iter().find(|s| s.failure.is_some());
     Ok(Buildability {
@@ -784,6 +789,7 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
         states,
         reliability,
         monte_carlo,
+        collapse_reliability,
     })
 }
 
@@ -898,6 +904,22 @@ pub fn text_report(r: &Resolved, b: &Buildability, out: Option<&std::path::Path>
             t,
             "reliability: print β {:.2}, P_f {:.3e} (governing: layer {} {})",
             rel.beta, rel.pf, rel.governing_state, rel.governing_check
+        );
+    }
+    if let Some(c) = &b.collapse_reliability {
+        let _ = writeln!(
+            t,
+            "collapse limit state: tables of {} layer counts over {} ({} path solves); at the \
+             design points table vs re-solve ≤ {:.2e} relative (Δβ ≤ {:.3})",
+            c.states.len(),
+            if c.parameters.is_empty() {
+                "γ alone (exact scaling)".to_owned()
+            } else {
+                c.parameters.join(", ")
+            },
+            c.solves,
+            c.max_relative_error,
+            c.max_beta_error
         );
     }
     if let Some(mc) = &b.monte_carlo {

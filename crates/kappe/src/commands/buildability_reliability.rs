@@ -47,6 +47,9 @@ use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
 use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
 use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
+use crate::commands::buildability_collapse::{
+    CollapseTables, IMPERFECTION, check_collapse_axes, imperfection_nominal,
+};
 use crate::input::error::DesignError;
 use crate::input::material::{MohrCoulomb, Strength, TimeLaw, TimeModel};
 use crate::input::uncertainty::{BETA_MIN_DEFAULT, UncertaintyTable};
@@ -72,12 +75,12 @@ pub const NODES: usize = 9;
 /// with probability ≈ 2 %, and such a sample is re-solved exactly, not extrapolated.
 pub const Z_RANGE: f64 = 5.0;
 
-const GAMMA: usize = 0;
-const E0: usize = 1;
-const RATE: usize = 2;
-const F0: usize = 3;
-const FRATE: usize = 4;
-const T: usize = 5;
+pub(crate) const GAMMA: usize = 0;
+pub(crate) const E0: usize = 1;
+pub(crate) const RATE: usize = 2;
+pub(crate) const F0: usize = 3;
+pub(crate) const FRATE: usize = 4;
+pub(crate) const T: usize = 5;
 
 /// Nominal values of the six parameters, in [`PARAMETERS`] order.
 fn nominal(r: &Resolved) -> [f64; 6] {
@@ -137,7 +140,7 @@ seed = {seed}
     )
 }
 
-fn uerr(field: impl Into<String>, message: impl Into<String>) -> DesignError {
+pub(crate) fn uerr(field: impl Into<String>, message: impl Into<String>) -> DesignError {
     DesignError::Uncertainty {
         field: field.into(),
         message: message.into(),
@@ -155,6 +158,9 @@ pub struct Prepared {
     pub idx: [Option<usize>; 6],
     /// Nominal values.
     pub nominal: [f64; 6],
+    /// The model index of `analysis.nonlinear.imperfection`, if uncertain
+    /// ([`crate::commands::buildability_collapse`]).
+    pub imperfection: Option<usize>,
 }
 
 impl Prepared {
@@ -181,9 +187,13 @@ pub fn prepare(r: &Resolved, table: &UncertaintyTable) -> Result<Prepared, Desig
         .collect::<Vec<_>>()
         .join(", ");
     let model = table.model_with(&|name: &str| {
+        if name == IMPERFECTION {
+            return imperfection_nominal(r);
+        }
         let Some(p) = PARAMETERS.iter().position(|(n, _)| *n == name) else {
             return Err(format!(
-                "unknown parameter of a buildability spec; allowed names: {allowed}"
+                "unknown parameter of a buildability spec; allowed names: {allowed} and, with \
+                 [analysis.nonlinear], \"{IMPERFECTION}\""
             ));
         };
         if nom[p].is_nan() {
@@ -201,12 +211,19 @@ pub fn prepare(r: &Resolved, table: &UncertaintyTable) -> Result<Prepared, Desig
             .iter()
             .position(|v| v.name == PARAMETERS[p].0)
     });
-    Ok(Prepared {
+    let imperfection = model
+        .variables()
+        .iter()
+        .position(|v| v.name == IMPERFECTION);
+    let prepared = Prepared {
         model,
         drifts: table.drifts(),
         idx,
         nominal: nom,
-    })
+        imperfection,
+    };
+    check_collapse_axes(r, &prepared)?;
+    Ok(prepared)
 }
 
 /// The spec at parameters `p` (time model, γ and layer time replaced), resolved again.
@@ -249,7 +266,12 @@ pub type StateValues = (Option<f64>, Option<f64>, Option<f64>);
 /// # Errors
 /// A failed solve or a refused parameter.
 pub fn exact_state(r: &Resolved, n: usize, p: &[f64; 6]) -> Result<StateValues, DesignError> {
-    let s = check_layers(&resolved_at(r, p)?, n)?;
+    let mut at = resolved_at(r, p)?;
+    // The linear checks only: the collapse path (its own limit state) would be wasted here.
+    if let Some(nl) = at.spec.analysis.as_mut().and_then(|a| a.nonlinear.as_mut()) {
+        nl.enabled = false;
+    }
+    let s = check_layers(&at, n)?;
     Ok((s.blf, s.strength_utilisation, s.sliding_utilisation))
 }
 
@@ -296,6 +318,9 @@ pub struct Surrogate {
     pub fallbacks: std::sync::atomic::AtomicU64,
     /// Wall-clock seconds of building the tables.
     pub build_seconds: f64,
+    /// The collapse factor's tables (with `[analysis.nonlinear]`; set by [`analyse`], not
+    /// shipped with [`SurrogateTables`]).
+    pub collapse: Option<CollapseTables>,
 }
 
 /// A [`Surrogate`]'s tables without its uncertain model: what a Dask client has built once and
@@ -399,12 +424,63 @@ impl SurrogateTables {
 }
 
 /// Print time of the state with n layers, h.
-fn t_hours(r: &Resolved, n: usize) -> f64 {
+pub(crate) fn t_hours(r: &Resolved, n: usize) -> f64 {
     r.schedule
         .layers
         .get(n.saturating_sub(1))
         .map_or(0.0, |l| l.end_s)
         / 3600.0
+}
+
+/// The barycentric coefficients at s outside the range [lo, hi] of `nodes`, for FORM only:
+/// the tables (all logarithms) continued as straight lines in s from the nearer edge (C¹;
+/// power laws in the variable), so that FORM's far iterates see a smooth surface. `out` is as
+/// long as `nodes` (at most [`NODES`]).
+pub(crate) fn bary_continued(
+    nodes: &[f64],
+    weights: &[f64],
+    [lo, hi]: [f64; 2],
+    s: f64,
+    out: &mut [f64],
+) {
+    let k = nodes.len().min(NODES);
+    let (e, inner) = if s < lo {
+        (lo, lo + 1e-3 * (hi - lo))
+    } else {
+        (hi, hi - 1e-3 * (hi - lo))
+    };
+    let mut ce = [0.0; NODES];
+    let mut ci = [0.0; NODES];
+    bary_into(nodes, weights, e, &mut ce[..k]);
+    bary_into(nodes, weights, inner, &mut ci[..k]);
+    let t = (s - e) / (e - inner);
+    for (j, c) in out.iter_mut().enumerate().take(k) {
+        *c = ce[j] + (ce[j] - ci[j]) * t;
+    }
+}
+
+/// Per model variable, the range [lo, hi] of ±[`Z_RANGE`] standard deviations over every
+/// state's drifted model (layer counts 1..=`max_layers`): the box the tables cover.
+///
+/// # Errors
+/// A drift factor that is not positive within the print.
+pub(crate) fn variable_box(
+    r: &Resolved,
+    prepared: &Prepared,
+) -> Result<Vec<[f64; 2]>, DesignError> {
+    let k = prepared.model.variables().len();
+    let mut out = vec![[f64::INFINITY, f64::NEG_INFINITY]; k];
+    for n in 1..=r.spec.object.max_layers {
+        let m = prepared
+            .model
+            .drifted(&prepared.drifts, t_hours(r, n))
+            .map_err(|e| uerr("uncertainty.drift", format!("state {n}: {e}")))?;
+        for (b, v) in out.iter_mut().zip(m.variables()) {
+            b[0] = b[0].min(v.distribution.from_standard(-Z_RANGE));
+            b[1] = b[1].max(v.distribution.from_standard(Z_RANGE));
+        }
+    }
+    Ok(out)
 }
 
 impl Surrogate {
@@ -459,26 +535,13 @@ impl Surrogate {
             && (!t_unc || t_scales)
             && (uniaxial || !stress)
             && (!(c.sliding && stress) || phi == 0.0)
-            && r.spec.nonlinear().is_none()
             && nom[E0] > 0.0;
-        let max = r.spec.object.max_layers;
         // The box of every state's (drifted) variables.
-        let (mut lo, mut hi) = ([f64::INFINITY; 6], [f64::NEG_INFINITY; 6]);
-        for n in 1..=max {
-            let m = prepared
-                .model
-                .drifted(&prepared.drifts, t_hours(r, n))
-                .map_err(|e| uerr("uncertainty.drift", format!("state {n}: {e}")))?;
-            for p in 0..6 {
-                let (a, b) = match prepared.idx[p].and_then(|i| m.variables().get(i)) {
-                    Some(v) => (
-                        v.distribution.from_standard(-Z_RANGE),
-                        v.distribution.from_standard(Z_RANGE),
-                    ),
-                    None => (nom[p], nom[p]),
-                };
-                lo[p] = lo[p].min(a);
-                hi[p] = hi[p].max(b);
+        let boxes = variable_box(r, &prepared)?;
+        let (mut lo, mut hi) = (nom, nom);
+        for p in 0..6 {
+            if let Some(b) = prepared.idx[p].and_then(|i| boxes.get(i)) {
+                [lo[p], hi[p]] = *b;
             }
         }
         let tf = |t: f64| if t_scales { t / nom[T] } else { 1.0 };
@@ -522,6 +585,7 @@ impl Surrogate {
             cos_phi,
             fallbacks: std::sync::atomic::AtomicU64::new(0),
             build_seconds: t0.elapsed().as_secs_f64(),
+            collapse: None,
         })
     }
 
@@ -584,6 +648,7 @@ impl Surrogate {
             cos_phi: *cos_phi,
             fallbacks: std::sync::atomic::AtomicU64::new(0),
             build_seconds: tables.build_seconds,
+            collapse: None,
         })
     }
 
@@ -643,22 +708,7 @@ impl Surrogate {
             let s = rho.ln();
             let [lo, hi] = self.range;
             if clamp && s.is_finite() && !(lo..=hi).contains(&s) {
-                // Outside the box, for FORM only: the tables (all logarithms) continued as
-                // straight lines in ln ρ from the edge (C¹, power laws), so that FORM's far
-                // iterates see a smooth surface.
-                let (e, inner) = if s < lo {
-                    (lo, lo + 1e-3 * (hi - lo))
-                } else {
-                    (hi, hi - 1e-3 * (hi - lo))
-                };
-                let mut ce = [0.0; NODES];
-                let mut ci = [0.0; NODES];
-                bary_into(&self.nodes, &self.weights, e, &mut ce[..k]);
-                bary_into(&self.nodes, &self.weights, inner, &mut ci[..k]);
-                let t = (s - e) / (e - inner);
-                for j in 0..k {
-                    coef[j] = ce[j] + (ce[j] - ci[j]) * t;
-                }
+                bary_continued(&self.nodes, &self.weights, self.range, s, coef);
             } else if !(s >= lo && s <= hi) {
                 self.fallbacks
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -913,7 +963,13 @@ pub fn monte_carlo_batch(
             let v = sur
                 .state(r, n, &p.params(&xn))
                 .map_err(|e| EvalError::from(e.to_string()))?;
-            if fails(v, blf_min) {
+            let collapses = || match &sur.collapse {
+                Some(c) => c
+                    .fails(r, p, n, &xn, false, &sur.fallbacks)
+                    .map_err(|e| EvalError::from(e.to_string())),
+                None => Ok(false),
+            };
+            if fails(v, blf_min) || collapses()? {
                 hits[n - 1] = true;
                 failed = true;
             }
@@ -1034,6 +1090,21 @@ pub fn reliability(
     states: &[(usize, StateValues)],
     table: &UncertaintyTable,
 ) -> Result<Reliability, DesignError> {
+    reliability_with_points(r, sur, states, table).map(|(rel, _)| rel)
+}
+
+/// [`reliability`] and the FORM result of every state's `collapse` component (layer count,
+/// result): the design points [`crate::commands::buildability_collapse::check_design_points`]
+/// re-solves.
+///
+/// # Errors
+/// See [`reliability`].
+pub fn reliability_with_points(
+    r: &Resolved,
+    sur: &Surrogate,
+    states: &[(usize, StateValues)],
+    table: &UncertaintyTable,
+) -> Result<(Reliability, Vec<(usize, FormResult)>), DesignError> {
     let t0 = kappe_fe::clock::Instant::now();
     let p = &sur.prepared;
     let blf_min = r.spec.checks.blf_min;
@@ -1043,7 +1114,8 @@ pub fn reliability(
         .par_iter()
         .map(|&(n, v)| -> Result<StateOut, DesignError> {
             let checks = random_checks(p, v);
-            if checks.is_empty() {
+            let collapse = sur.collapse.as_ref().filter(|c| c.has(n));
+            if checks.is_empty() && collapse.is_none() {
                 return Ok(None);
             }
             let th = t_hours(r, n);
@@ -1096,6 +1168,10 @@ pub fn reliability(
                     (name, b)
                 })
                 .collect();
+            let mut named = named;
+            if let Some(c) = collapse {
+                named.push(("collapse", c.limit_state(r, p, n)));
+            }
             form_checks(&model, named, n, th, seed)
                 .map(Some)
                 .map_err(|e| {
@@ -1108,8 +1184,12 @@ pub fn reliability(
         .collect::<Result<Vec<_>, _>>()?;
     let mut results = Vec::new();
     let mut out = Vec::new();
+    let mut points = Vec::new();
     for (s, rs) in per_state.into_iter().flatten() {
         for (name, f) in rs {
+            if name == "collapse" {
+                points.push((s.index, f.clone()));
+            }
             results.push((s.index, name, f));
         }
         out.push(s);
@@ -1131,6 +1211,7 @@ pub fn reliability(
         BETA_MIN_DEFAULT,
         t0,
     )
+    .map(|rel| (rel, points))
 }
 
 /// FORM of every checked layer count and of the print, and the Monte Carlo when
@@ -1143,8 +1224,11 @@ pub fn analyse(
     r: &Resolved,
     table: &UncertaintyTable,
     states: &[crate::commands::buildability::BuildState],
-) -> Result<(Reliability, Option<PrintMonteCarlo>), DesignError> {
-    let sur = Surrogate::build(r, prepare(r, table)?)?;
+) -> Result<Analysed, DesignError> {
+    let mut sur = Surrogate::build(r, prepare(r, table)?)?;
+    if r.spec.nonlinear().is_some() {
+        sur.collapse = Some(CollapseTables::build(r, &sur.prepared, states)?);
+    }
     let values: Vec<(usize, StateValues)> = states
         .iter()
         .map(|s| {
@@ -1154,10 +1238,22 @@ pub fn analyse(
             )
         })
         .collect();
-    let rel = reliability(r, &sur, &values, table)?;
+    let (rel, points) = reliability_with_points(r, &sur, &values, table)?;
+    let collapse = match &sur.collapse {
+        Some(c) => Some(c.report(r, &sur.prepared, &points)?),
+        None => None,
+    };
     let mc = match table.monte_carlo {
         Some(n) => Some(monte_carlo(r, &sur, n, table.seed.unwrap_or(0))?),
         None => None,
     };
-    Ok((rel, mc))
+    Ok((rel, mc, collapse))
 }
+
+/// What [`analyse`] adds to a buildability run: FORM, the Monte Carlo (if asked for) and the
+/// collapse limit state's tables and design-point checks (with `[analysis.nonlinear]`).
+pub type Analysed = (
+    Reliability,
+    Option<PrintMonteCarlo>,
+    Option<crate::commands::buildability_collapse::CollapseReliability>,
+);

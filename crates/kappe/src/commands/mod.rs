@@ -6,6 +6,7 @@
 //! ([`templates`]).
 
 pub mod buildability;
+pub mod buildability_collapse;
 pub mod buildability_reliability;
 pub mod calibrate_blf;
 pub mod calibrate_print;

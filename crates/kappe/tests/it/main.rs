@@ -5,6 +5,7 @@ mod analysis_loop;
 mod analysis_props;
 mod asprinted;
 mod blf_convergence;
+mod buildability_collapse;
 mod buildability_reliability;
 mod cap;
 mod ceiling;
