@@ -6,8 +6,8 @@
 //! with `[analysis.nonlinear]` (the rule's w0, clamped base) and two uncertain inputs, chosen
 //! before this example was first run (docs/reliability.md, "Collapse as a limit state"):
 //! - the imperfection, a factor on the rule's w0, lognormal with mean 1 and cov 0.5;
-//! - E₀, lognormal with cov 0.15 (the value of the project's illustrative scatter,
-//!   `example_scatter`).
+//! - E₀, lognormal with cov 0.15, and γ, normal with cov 0.02 (the values of the project's
+//!   illustrative scatter, `example_scatter`; γ scales λ_c exactly and adds no table axis).
 //!
 //! 1. `kappe buildability`'s run without and with the uncertainty: wall and CPU time.
 //! 2. Per layer count: the nominal collapse factor, FORM's collapse β and P_f, the Monte Carlo's
@@ -42,6 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scatter = format!(
         "\n[uncertainty]\n\"{IMPERFECTION}\" = {{ dist = \"lognormal\", cov = 0.5 }}\n\
          \"material.time.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}\n\
+         \"material.specific_weight\" = {{ dist = \"normal\", cov = 0.02 }}\n\
          monte_carlo = {samples}\nseed = 1\n"
     );
     println!(
@@ -70,12 +71,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cpu_seconds().unwrap_or(f64::NAN) - c1,
     );
     println!(
-        "with [uncertainty] (w0 factor cov 0.5, E₀ cov 0.15, {samples} samples): {w1:.1} s wall, \
+        "with [uncertainty] (w0 factor cov 0.5, E₀ cov 0.15, γ cov 0.02, {samples} samples): {w1:.1} s wall, \
          {cpu1:.1} s CPU ({:.1}× the CPU without); load average {}",
         cpu1 / cpu0,
         load_average()
     );
-    let (Some(rel), Some(mc), Some(col)) = (&b.reliability, &b.monte_carlo, &b.collapse_reliability)
+    let (Some(rel), Some(mc), Some(col)) =
+        (&b.reliability, &b.monte_carlo, &b.collapse_reliability)
     else {
         return Err("no reliability block".into());
     };

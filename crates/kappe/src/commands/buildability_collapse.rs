@@ -61,15 +61,19 @@
 //!
 //! # Which layer counts get a table
 //!
-//! A state can fail by collapse inside the box only if its ln-margin G_n = ln(λ_c,n/collapse_min)
-//! at the means is at most its own downward span D_n = G_n − min over the box of g_n. The
-//! state of least G_n is tabulated first; D_n of a tabulated state is measured on its grid (the
-//! least node value, and γ at the top of its box). Every state with G_n ≤ [`SPAN_SAFETY`]·D_max
-//! (D_max the largest span measured so far) is then tabulated, and again with the new spans,
-//! until no state is added. A skipped state could fail inside the box only if its own span
-//! exceeded 1.5× every span measured on the same object — an argument from the measured spans
-//! of neighbouring states (the same wall, material and scatter), not a proof; its collapse
-//! then counts neither in FORM nor in the Monte Carlo. A state whose nominal λ_c is 0 (a
+//! A state can fail by collapse inside the selection box (±[`Z_SELECT`] = 4 standard
+//! deviations per variable) only if its ln-margin G_n = ln(λ_c,n/collapse_min) at the means is
+//! at most its own downward span D_n = G_n − min over that box of g_n. The state of least G_n
+//! is tabulated first; D_n of a tabulated state is measured on its interpolant (9 points per
+//! axis over the selection box, γ at the box's top). Every state with G_n ≤
+//! [`SPAN_SAFETY`]·D_max (D_max the largest span measured so far) is then tabulated, and again
+//! with the new spans, until no state is added. A skipped state could fail inside the
+//! selection box only if its own span exceeded 1.5× every span measured on the same object — an
+//! argument from the measured spans of neighbouring states (the same wall, material and
+//! scatter), not a proof — and outside it only with P ≲ 10⁻⁴; its collapse then counts neither
+//! in FORM nor in the Monte Carlo. (The first version used the whole ±5σ table box: with w0's
+//! cov 0.5 that is w0 × [0.09, 11], and every layer count down to the first was admitted,
+//! whose FORM then wandered to E₀ → 0 on a flat, extrapolated surface.) A state whose nominal λ_c is 0 (a
 //! mechanism) fails in every sample. Without any axis every state gets its exact table.
 //!
 //! # Kinks
@@ -113,6 +117,14 @@ pub const MAX_AXES: usize = 2;
 
 /// The margin on the measured spans of the state rule (module docs).
 pub const SPAN_SAFETY: f64 = 1.5;
+
+/// Half-width of the state rule's box, in standard deviations: a state that cannot fail inside
+/// it has P_f ≤ P(some |zᵢ| > 4) ≈ d·6.3·10⁻⁵ (d ≤ 2 axes, and γ), negligible against any print
+/// P_f the β target admits (Φ(−2.3) ≈ 10⁻²).
+pub const Z_SELECT: f64 = 4.0;
+
+/// Points per axis on which the state rule evaluates a table's interpolant.
+const SELECT_POINTS: usize = 9;
 
 /// The table's error at a design point, as Δβ = |ln λ_table − ln λ_path|/‖∇ᵤg‖, that the tests
 /// accept: below FORM's own first-order error measured on these objects (Δβ ≈ 0.07 on study
@@ -316,6 +328,8 @@ impl CollapseTables {
         let gamma_hi = p.idx[GAMMA]
             .and_then(|i| boxes.get(i))
             .map_or(gamma0, |b| b[1]);
+        // γ at the top of the selection box (a normal: linear in z).
+        let gamma_select = (1.0 + Z_SELECT / Z_RANGE * (gamma_hi / gamma0 - 1.0)).ln();
         let collapse_min = r.spec.checks.collapse_min;
         let mut mechanisms = Vec::new();
         let mut order: Vec<(usize, f64)> = Vec::new();
@@ -354,7 +368,7 @@ impl CollapseTables {
                     })
                 })
                 .collect();
-            out.span = (gamma_hi / gamma0).ln();
+            out.span = gamma_select;
         } else {
             let mut next: Vec<usize> = order.first().map(|s| s.0).into_iter().collect();
             while !next.is_empty() {
@@ -364,9 +378,7 @@ impl CollapseTables {
                         .iter()
                         .find(|s| s.0 == t.layers)
                         .map_or(f64::NAN, |s| s.1);
-                    let least = t.log.iter().copied().fold(f64::INFINITY, f64::min)
-                        - collapse_min.ln()
-                        - (gamma_hi / gamma0).ln();
+                    let least = out.least_log(&t) - collapse_min.ln() - gamma_select;
                     out.span = out.span.max(g - least);
                     out.states.push(t);
                 }
@@ -445,6 +457,49 @@ impl CollapseTables {
             .collect())
     }
 
+    /// The least ln λ_c (at γ₀) of table `t` over the selection box: ±[`Z_SELECT`] of the
+    /// ±[`Z_RANGE`] box in each axis' logarithm (exact for a lognormal without drift, whose
+    /// logarithm is linear in z), on [`SELECT_POINTS`] points per axis of the interpolant
+    /// (nodes and edges included).
+    fn least_log(&self, t: &StateTable) -> f64 {
+        let k = SELECT_POINTS;
+        let total = k.pow(self.axes.len() as u32);
+        (0..total)
+            .map(|j| {
+                let mut rest = j;
+                let mut coefs = Vec::with_capacity(self.axes.len());
+                for a in self.axes.iter().rev() {
+                    let i = rest % k;
+                    rest /= k;
+                    let [lo, hi] = a.range;
+                    let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo) * Z_SELECT / Z_RANGE);
+                    let s = mid - half + 2.0 * half * i as f64 / (k - 1) as f64;
+                    let mut c = vec![0.0; a.nodes.len()];
+                    bary_into(&a.nodes, &a.weights, s, &mut c);
+                    coefs.push(c);
+                }
+                coefs.reverse();
+                self.interpolate(t, &coefs)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The table's interpolant from per-axis barycentric coefficients.
+    fn interpolate(&self, t: &StateTable, coefs: &[Vec<f64>]) -> f64 {
+        t.log
+            .iter()
+            .enumerate()
+            .map(|(j, v)| {
+                let w: f64 = grid_index(&self.axes, j)
+                    .iter()
+                    .zip(coefs)
+                    .map(|(&i, c)| c.get(i).copied().unwrap_or(0.0))
+                    .product();
+                w * v
+            })
+            .sum()
+    }
+
     fn has_table(&self, n: usize) -> bool {
         self.states.iter().any(|s| s.layers == n)
     }
@@ -508,7 +563,11 @@ impl CollapseTables {
             let [lo, hi] = a.range;
             if s >= lo && s <= hi {
                 bary_into(&a.nodes, &a.weights, s, &mut c);
-            } else if clamp && s.is_finite() {
+            } else if clamp && !s.is_nan() {
+                // A FORM iterate far out (x → 0 or ∞ underflows the logarithm): held at 10³
+                // box widths beyond the edge, where the continued line stays finite.
+                let far = 1e3 * (hi - lo);
+                let s = s.clamp(lo - far, hi + far);
                 bary_continued(&a.nodes, &a.weights, a.range, s, &mut c);
             } else {
                 fallbacks.fetch_add(1, Ordering::Relaxed);
@@ -516,19 +575,7 @@ impl CollapseTables {
             }
             coefs.push(c);
         }
-        let log: f64 = t
-            .log
-            .iter()
-            .enumerate()
-            .map(|(j, v)| {
-                let w: f64 = grid_index(&self.axes, j)
-                    .iter()
-                    .zip(&coefs)
-                    .map(|(&i, c)| c.get(i).copied().unwrap_or(0.0))
-                    .product();
-                w * v
-            })
-            .sum();
+        let log = self.interpolate(t, &coefs);
         let gamma = p.params(x)[GAMMA];
         Ok(Some(log.exp() * self.gamma0 / gamma))
     }
@@ -574,7 +621,7 @@ impl CollapseTables {
         p: &'a Prepared,
         n: usize,
     ) -> Box<dyn LimitState + 'a> {
-        Box::new(Fallible(move |x: &[f64]| self.g(r, p, n, x)))
+        Box::new(Fallible(move |x: &[f64]| self.g(r, p, n, &p.floored(x))))
     }
 
     /// The tables' summary and the check of every state's collapse design point (`points`:

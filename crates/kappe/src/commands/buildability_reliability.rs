@@ -164,6 +164,24 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// `x` with every positive variable (all but γ) floored at the least positive number: a
+    /// FORM iterate on a surface nearly flat in a lognormal variable (strength with E₀ alone
+    /// uncertain depends on it only through ρ) steps towards u → −∞, where x underflows to 0
+    /// and a central difference then crosses into x < 0. Floored, every g stays finite, and
+    /// FORM reports the component's far β (left out beyond `FAR_BETA`) instead of failing.
+    pub fn floored(&self, x: &[f64]) -> Vec<f64> {
+        x.iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                if Some(i) == self.idx[GAMMA] {
+                    v
+                } else {
+                    v.max(f64::MIN_POSITIVE)
+                }
+            })
+            .collect()
+    }
+
     /// The six parameters at the model point x (nominal where not uncertain).
     pub fn params(&self, x: &[f64]) -> [f64; 6] {
         std::array::from_fn(|p| {
@@ -707,8 +725,19 @@ impl Surrogate {
             let rho = p[RATE] / p[E0] * tf;
             let s = rho.ln();
             let [lo, hi] = self.range;
-            if clamp && s.is_finite() && !(lo..=hi).contains(&s) {
-                bary_continued(&self.nodes, &self.weights, self.range, s, coef);
+            if clamp && !s.is_nan() && !(lo..=hi).contains(&s) {
+                // A FORM iterate far out (E₀ → 0 underflows: a check that depends on E₀ only
+                // through ρ, e.g. strength with E₀ alone uncertain, has a flat surface there)
+                // is held at 10³ box widths beyond the edge: finite, so FORM reports its far
+                // β instead of failing on an evaluation.
+                let far = 1e3 * (hi - lo);
+                bary_continued(
+                    &self.nodes,
+                    &self.weights,
+                    self.range,
+                    s.clamp(lo - far, hi + far),
+                    coef,
+                );
             } else if !(s >= lo && s <= hi) {
                 self.fallbacks
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -1078,6 +1107,50 @@ fn random_checks(p: &Prepared, v: StateValues) -> Vec<&'static str> {
     out
 }
 
+/// A component's first-order β at the means, G(0)/‖∇ᵤG(0)‖ by central differences (step 10⁻³
+/// in u, on the tables: microseconds), above which it is left out of FORM.
+pub const FAR_FIRST_ORDER: f64 = 16.0;
+
+/// A component's first-order β at the means (∞ when it does not depend on the variables, NaN
+/// when an evaluation fails: kept). Beyond [`FAR_FIRST_ORDER`] a state's component is left out
+/// unless it is the state's nearest. Such a component holds P_f ≪ 10⁻⁵⁰
+/// unless its surface curves towards the origin by more than half its distance, and FORM far
+/// out fails on it instead: the strength of a layer at u = 0.3 with only γ (cov 0.02) and E₀
+/// uncertain lies ~60 σ of γ away, beyond γ = 0, and a check that depends on E₀ only through
+/// ρ is nearly flat (HL-RF steps to E₀ → 0). A component whose evaluation fails here is kept
+/// (FORM reports it).
+fn first_order_at_the_means(
+    model: &kappe_reliability::Model,
+    g: &mut dyn kappe_reliability::LimitState,
+) -> f64 {
+    let k = model.variables().len();
+    let at = |g: &mut dyn kappe_reliability::LimitState, i: usize, h: f64| {
+        let mut u = vec![0.0; k];
+        if let Some(v) = u.get_mut(i) {
+            *v = h;
+        }
+        g.value(&model.x_from_u(&u))
+    };
+    let Ok(g0) = at(g, k, 0.0) else {
+        return f64::NAN;
+    };
+    let h = 1e-3;
+    let mut norm2 = 0.0;
+    for i in 0..k {
+        match (at(g, i, h), at(g, i, -h)) {
+            (Ok(a), Ok(b)) => norm2 += ((a - b) / (2.0 * h)).powi(2),
+            _ => return f64::NAN,
+        }
+    }
+    if norm2 > 0.0 {
+        g0 / norm2.sqrt()
+    } else if g0 > 0.0 {
+        f64::INFINITY
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
 /// FORM of every check of the layer counts `states` (n, its deterministic values) and the
 /// print's series system; per state its [`StateReliability`] (index = n) and its check results.
 ///
@@ -1149,6 +1222,7 @@ pub fn reliability_with_points(
                 .iter()
                 .map(|&(name, layer)| {
                     let g = move |x: &[f64]| -> Result<f64, EvalError> {
+                        let x = &p.floored(x);
                         let v = sur
                             .state_layers(r, n, &p.params(x), true, layer)
                             .map_err(|e| EvalError::from(e.to_string()))?;
@@ -1172,6 +1246,22 @@ pub fn reliability_with_points(
             if let Some(c) = collapse {
                 named.push(("collapse", c.limit_state(r, p, n)));
             }
+            // Far components left out, but the nearest one kept so that every state keeps a β.
+            let b1: Vec<f64> = named
+                .iter_mut()
+                .map(|(_, g)| first_order_at_the_means(&model, g.as_mut()))
+                .collect();
+            let nearest = b1
+                .iter()
+                .enumerate()
+                .filter(|b| b.1.is_finite())
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|b| b.0);
+            let mut k = 0;
+            named.retain(|_| {
+                k += 1;
+                b1.get(k - 1).is_none_or(|&b| !(b > FAR_FIRST_ORDER)) || nearest == Some(k - 1)
+            });
             form_checks(&model, named, n, th, seed)
                 .map(Some)
                 .map_err(|e| {

@@ -27,12 +27,14 @@ fn small(nonlinear: &str, extra: &str) -> String {
     )
 }
 
-/// w0 (a factor on the rule's w0, lognormal, cov 0.5) and E₀ (lognormal, cov 0.15): the
-/// scatter of the example `buildability_collapse` (docs/reliability.md, "Collapse").
+/// w0 (a factor on the rule's w0, lognormal, cov 0.5), E₀ (lognormal, cov 0.15) and γ
+/// (normal, cov 0.02): the scatter of the example `buildability_collapse` (docs/reliability.md,
+/// "Collapse as a limit state").
 fn scatter(seed: u64, monte_carlo: bool) -> String {
     format!(
         "[uncertainty]\n\"{IMPERFECTION}\" = {{ dist = \"lognormal\", cov = 0.5 }}\n\
          \"material.time.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}\n\
+         \"material.specific_weight\" = {{ dist = \"normal\", cov = 0.02 }}\n\
          seed = {seed}\n{}",
         if monte_carlo {
             "monte_carlo = 2000\n"
@@ -132,6 +134,7 @@ fn form_of_the_collapse_agrees_with_monte_carlo_on_the_table() {
             )
         })
         .collect();
+    eprintln!("{:?}", sur.collapse);
     let (rel, points) = reliability_with_points(&r, &sur, &values, &table).unwrap();
     let col = sur.collapse.as_ref().unwrap();
     eprintln!(
