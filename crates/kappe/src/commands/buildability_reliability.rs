@@ -1260,7 +1260,9 @@ pub fn reliability_with_points(
             let mut k = 0;
             named.retain(|_| {
                 k += 1;
-                b1.get(k - 1).is_none_or(|&b| !(b > FAR_FIRST_ORDER)) || nearest == Some(k - 1)
+                b1.get(k - 1)
+                    .is_none_or(|&b| b.is_nan() || b <= FAR_FIRST_ORDER)
+                    || nearest == Some(k - 1)
             });
             form_checks(&model, named, n, th, seed)
                 .map(Some)
