@@ -132,6 +132,7 @@ impl From<ConvergedWire> for ConvergedFactor {
                     factor,
                     n_free_dofs,
                     steps,
+                    solver: Default::default(),
                 })
                 .collect(),
             extrapolated: w.extrapolated,

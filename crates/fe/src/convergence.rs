@@ -24,6 +24,7 @@ use crate::error::FeError;
 use crate::model::ShellModel;
 use crate::refine::split;
 use crate::solver::{BucklingOptions, BucklingResult, buckling};
+use crate::twolevel::{TwoLevel, TwoLevelOptions, split_buckling};
 
 /// One mesh of the sequence.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,8 +35,35 @@ pub struct MeshLevel {
     pub factor: f64,
     /// Free DOFs.
     pub n_free_dofs: usize,
-    /// Lanczos steps of its solve.
+    /// Lanczos steps of its solve (a two-level solve: applications of its two-grid cycle).
     pub steps: usize,
+    /// How this level was solved.
+    pub solver: LevelSolve,
+}
+
+/// How a mesh level was solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LevelSolve {
+    /// Its own LLᵀ and Lanczos (the model's own mesh, and every split with
+    /// [`SplitSolver::Direct`]).
+    #[default]
+    Direct,
+    /// The two-level solver ([`crate::twolevel`]), every guard passed.
+    TwoLevel,
+    /// The two-level solver declined (a guard failed, or it could not run) and the split was
+    /// solved directly.
+    Fallback,
+}
+
+/// The solver of the split levels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SplitSolver {
+    /// LLᵀ of the split's K and Lanczos started from the coarser level's mode.
+    #[default]
+    Direct,
+    /// [`crate::twolevel::split_buckling`] preconditioned by the coarser level, falling back to
+    /// the direct solve when it declines.
+    TwoLevel,
 }
 
 /// The converged estimate of the lowest factor.
@@ -109,6 +137,7 @@ pub fn converge_factor(
         factor: f0,
         n_free_dofs: coarse.stats.n_free_dofs,
         steps: coarse.stats.operator_applications,
+        solver: LevelSolve::Direct,
     };
     converge_from(
         model,
@@ -135,6 +164,34 @@ pub fn converge_from(
     tolerance: f64,
     max_split: usize,
 ) -> Result<Option<ConvergedFactor>, FeError> {
+    converge_from_with(
+        model,
+        coarse,
+        mode,
+        options,
+        tolerance,
+        max_split,
+        SplitSolver::Direct,
+    )
+}
+
+/// [`converge_from`] with the split levels solved by `solver`. [`SplitSolver::TwoLevel`] solves
+/// each split with [`crate::twolevel::split_buckling`] on the level below it (default
+/// [`crate::twolevel::TwoLevelOptions`], its eigen-tolerance `options.tolerance`), and directly
+/// where that declines ([`LevelSolve::Fallback`]): the result is the direct solve's to within
+/// the eigen-solvers' tolerances (docs/convergence.md, "The `twogrid` branch").
+///
+/// # Errors
+/// A split mesh that cannot be solved.
+pub fn converge_from_with(
+    model: &ShellModel,
+    coarse: MeshLevel,
+    mode: Option<Vec<[f64; 6]>>,
+    options: &BucklingOptions,
+    tolerance: f64,
+    max_split: usize,
+    solver: SplitSolver,
+) -> Result<Option<ConvergedFactor>, FeError> {
     let mut levels = vec![coarse];
     let mut current = model.clone();
     let mut mode = mode.filter(|m| m.len() == model.nodes.len());
@@ -142,31 +199,70 @@ pub fn converge_from(
     loop {
         let refined = split(&current, 2);
         split_n *= 2;
-        let start = mode.as_ref().map(|m| refined.prolong(m));
-        let r = buckling(
-            &refined.model,
-            &BucklingOptions {
-                modes: 1,
-                start,
-                sturm_check: false,
-                ..options.clone()
-            },
-        )?;
-        let Some(&f) = r.factors.first() else {
-            return Ok(None);
+        let two_level = match solver {
+            SplitSolver::Direct => None,
+            SplitSolver::TwoLevel => {
+                let opts = TwoLevelOptions {
+                    eigen_tolerance: options.tolerance,
+                    seed: options.seed,
+                    ..TwoLevelOptions::default()
+                };
+                // An error of the two-level solve (e.g. a split that is a mechanism) is the
+                // direct solve's to report: it falls back.
+                match split_buckling(&current, &refined, mode.as_deref(), &opts) {
+                    Ok(TwoLevel::Solved(s)) => Some(Some(s)),
+                    Ok(TwoLevel::Declined { .. }) | Err(_) => Some(None),
+                }
+            }
         };
-        levels.push(MeshLevel {
-            split: split_n,
-            factor: f,
-            n_free_dofs: r.stats.n_free_dofs,
-            steps: r.stats.operator_applications,
-        });
+        let (level, next_mode) = match two_level {
+            Some(Some(s)) => (
+                MeshLevel {
+                    split: split_n,
+                    factor: s.factor,
+                    n_free_dofs: s.stats.n_free_fine,
+                    steps: s.stats.cycles,
+                    solver: LevelSolve::TwoLevel,
+                },
+                Some(s.mode),
+            ),
+            declined => {
+                let start = mode.as_ref().map(|m| refined.prolong(m));
+                let r = buckling(
+                    &refined.model,
+                    &BucklingOptions {
+                        modes: 1,
+                        start,
+                        sturm_check: false,
+                        ..options.clone()
+                    },
+                )?;
+                let Some(&f) = r.factors.first() else {
+                    return Ok(None);
+                };
+                (
+                    MeshLevel {
+                        split: split_n,
+                        factor: f,
+                        n_free_dofs: r.stats.n_free_dofs,
+                        steps: r.stats.operator_applications,
+                        solver: if declined.is_some() {
+                            LevelSolve::Fallback
+                        } else {
+                            LevelSolve::Direct
+                        },
+                    },
+                    r.modes.into_iter().next(),
+                )
+            }
+        };
+        levels.push(level);
         let est = ConvergedFactor::from_pair(levels.clone(), tolerance);
         let done = est.as_ref().is_none_or(|e| e.converged) || 2 * split_n > max_split.max(2);
         if done {
             return Ok(est);
         }
-        mode = r.modes.into_iter().next();
+        mode = next_mode;
         current = refined.model;
     }
 }
@@ -181,6 +277,7 @@ mod tests {
             factor,
             n_free_dofs: 0,
             steps: 0,
+            solver: LevelSolve::Direct,
         }
     }
 

@@ -62,8 +62,12 @@ pub mod oracle;
 pub mod refine;
 mod solver;
 pub mod summary;
+pub mod twolevel;
 
-pub use convergence::{ConvergedFactor, MeshLevel, converge_factor, converge_from};
+pub use convergence::{
+    ConvergedFactor, LevelSolve, MeshLevel, SplitSolver, converge_factor, converge_from,
+    converge_from_with,
+};
 pub use error::{FeError, NodeDof};
 pub use model::{ElementKind, Material, NodalLoad, ShellModel, Support};
 pub use nonlinear::{

@@ -741,24 +741,10 @@ impl BucklingSolver {
             k: &kvals,
             kg: &kg,
         };
-        let guess = options.start.as_ref().map(|g| {
-            let mut v: Vec<f64> = self
-                .dofs
-                .free
-                .iter()
-                .map(|&d| g.get(d / 6).map_or(0.0, |v| v[d % 6]))
-                .collect();
-            // The guess alone can lack mode 1 entirely (the previous state's mode may be this
-            // state's second, or of another symmetry): the seeded random part keeps every mode
-            // in the Krylov space, so the top Ritz pair cannot converge to a higher mode first.
-            let scale = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-            if scale > 0.0 {
-                for (i, x) in v.iter_mut().enumerate() {
-                    *x += scale * WARM_START_NOISE * random_unit(options.seed ^ 0x5eed, i as u64);
-                }
-            }
-            v
-        });
+        let guess = options
+            .start
+            .as_ref()
+            .map(|g| start_vector(&self.dofs, g, options.seed));
         let mut found = lanczos(&ops, &llt, k, options, guess, &[], max_steps, &mut stats)?;
         // The factor of K is released before the Sturm LDLᵀ so the two never coexist (peak
         // memory at 10⁵ nodes); a deflated restart re-factors K, which is rarely needed.
@@ -831,17 +817,7 @@ impl BucklingSolver {
         for p in found.iter().take(k) {
             factors.push(p.lambda);
             residuals.push(ops.pencil_residual(p.lambda, &p.vector));
-            let mut shape = vec![[0.0; 6]; model.nodes.len()];
-            let scale = p
-                .vector
-                .iter()
-                .copied()
-                .fold(0.0_f64, |m, v| if v.abs() > m.abs() { v } else { m });
-            let scale = if scale == 0.0 { 1.0 } else { scale };
-            for (i, &g) in self.dofs.free.iter().enumerate() {
-                shape[g / 6][g % 6] = p.vector[i] / scale;
-            }
-            modes.push(shape);
+            modes.push(mode_shape(&self.dofs, model.nodes.len(), &p.vector));
         }
         Ok((
             BucklingResult {
@@ -925,17 +901,17 @@ impl BucklingSolver {
 }
 
 /// The operators of the pencil on the free DOFs.
-struct Ops<'a> {
-    pattern: &'a Pattern,
-    k: &'a [f64],
-    kg: &'a [f64],
+pub(crate) struct Ops<'a> {
+    pub(crate) pattern: &'a Pattern,
+    pub(crate) k: &'a [f64],
+    pub(crate) kg: &'a [f64],
 }
 
 impl Ops<'_> {
-    fn k_mul(&self, x: &[f64], y: &mut [f64]) {
+    pub(crate) fn k_mul(&self, x: &[f64], y: &mut [f64]) {
         self.pattern.sym_matvec(self.k, x, y);
     }
-    fn kg_mul(&self, x: &[f64], y: &mut [f64]) {
+    pub(crate) fn kg_mul(&self, x: &[f64], y: &mut [f64]) {
         self.pattern.sym_matvec(self.kg, x, y);
     }
     fn pencil_residual(&self, lambda: f64, phi: &[f64]) -> f64 {
@@ -956,9 +932,9 @@ impl Ops<'_> {
 }
 
 /// A converged eigenpair: λ and the K-normalised vector on the free DOFs.
-struct Pair {
-    lambda: f64,
-    vector: Vec<f64>,
+pub(crate) struct Pair {
+    pub(crate) lambda: f64,
+    pub(crate) vector: Vec<f64>,
 }
 
 /// Size of the seeded random part of a warm start, relative to the guess's largest entry. It is
@@ -969,9 +945,46 @@ struct Pair {
 /// saving: on a 4.8 m cap's 544 states 1e-3 costs 6 % more Lanczos time than no noise, 1e-1 12 %.
 const WARM_START_NOISE: f64 = 1e-3;
 
+/// A vector on the free DOFs `dofs` as a mode per node (`n_nodes` of them), scaled so that its
+/// largest entry is +1.
+pub(crate) fn mode_shape(dofs: &DofMap, n_nodes: usize, vector: &[f64]) -> Vec<[f64; 6]> {
+    let mut shape = vec![[0.0; 6]; n_nodes];
+    let scale = vector
+        .iter()
+        .copied()
+        .fold(0.0_f64, |m, v| if v.abs() > m.abs() { v } else { m });
+    let scale = if scale == 0.0 { 1.0 } else { scale };
+    for (i, &g) in dofs.free.iter().enumerate() {
+        if let (Some(s), Some(v)) = (shape.get_mut(g / 6), vector.get(i)) {
+            s[g % 6] = v / scale;
+        }
+    }
+    shape
+}
+
+/// A mode guess per node (`[ux, uy, uz, rx, ry, rz]`) as a Lanczos start on the free DOFs
+/// `dofs`, blended with the seeded random vector. The guess alone can lack mode 1 entirely (the
+/// previous state's mode may be this state's second, or of another symmetry): the seeded random
+/// part keeps every mode in the Krylov space, so the top Ritz pair cannot converge to a higher
+/// mode first.
+pub(crate) fn start_vector(dofs: &DofMap, g: &[[f64; 6]], seed: u64) -> Vec<f64> {
+    let mut v: Vec<f64> = dofs
+        .free
+        .iter()
+        .map(|&d| g.get(d / 6).map_or(0.0, |v| v[d % 6]))
+        .collect();
+    let scale = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if scale > 0.0 {
+        for (i, x) in v.iter_mut().enumerate() {
+            *x += scale * WARM_START_NOISE * random_unit(seed ^ 0x5eed, i as u64);
+        }
+    }
+    v
+}
+
 /// Uniform pseudo-random number in [−1, 1] from (seed, i) (SplitMix64 finaliser), so the start
 /// vector is reproducible without a generator dependency.
-fn random_unit(seed: u64, i: u64) -> f64 {
+pub(crate) fn random_unit(seed: u64, i: u64) -> f64 {
     let mut z = seed
         .wrapping_add(0x9e37_79b9_7f4a_7c15)
         .wrapping_add(i.wrapping_mul(0xbf58_476d_1ce4_e5b9));
@@ -981,7 +994,7 @@ fn random_unit(seed: u64, i: u64) -> f64 {
     (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -1006,7 +1019,7 @@ fn k_orthogonalize(basis: &[&[f64]], kbasis: &[&[f64]], r: &mut [f64], kr: &mut 
 /// explicit restarts (locking converged pairs). Returns up to `want` pairs with the largest
 /// positive μ = 1/λ, K-orthogonal to `locked_in`.
 #[allow(clippy::too_many_arguments)]
-fn lanczos(
+pub(crate) fn lanczos(
     ops: &Ops<'_>,
     llt: &Llt<'_>,
     want: usize,

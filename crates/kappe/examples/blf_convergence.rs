@@ -123,6 +123,7 @@ fn states(
                     factor: l.1,
                     n_free_dofs: l.2,
                     steps: 0,
+                    solver: kappe_fe::LevelSolve::Direct,
                 })
                 .collect(),
             AnalysisOptions::default().blf_tolerance,

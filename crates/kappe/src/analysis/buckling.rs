@@ -509,14 +509,20 @@ pub fn state_refine(
         factor: coarse,
         n_free_dofs: 0,
         steps: 0,
+        solver: kappe_fe::LevelSolve::Direct,
     };
-    kappe_fe::converge_from(
+    kappe_fe::converge_from_with(
         &shell.model,
         level,
         start,
         &fe_opts,
         options.blf_tolerance,
         options.blf_max_split,
+        if options.blf_two_level {
+            kappe_fe::SplitSolver::TwoLevel
+        } else {
+            kappe_fe::SplitSolver::Direct
+        },
     )
     .map_err(|e| DesignError::State {
         state: state.index,

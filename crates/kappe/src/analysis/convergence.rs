@@ -259,6 +259,7 @@ pub fn interpolated(coarse: f64, ratio: f64, e: f64, tolerance: f64) -> Converge
         factor,
         n_free_dofs: 0,
         steps: 0,
+        solver: kappe_fe::LevelSolve::Direct,
     };
     let pair = vec![level(1, coarse), level(2, ratio * coarse)];
     let mut c = ConvergedFactor::from_pair(pair, tolerance).unwrap_or(ConvergedFactor {
@@ -292,12 +293,14 @@ mod tests {
                     factor: coarse,
                     n_free_dofs: 0,
                     steps: 0,
+                    solver: kappe_fe::LevelSolve::Direct,
                 },
                 MeshLevel {
                     split: 2,
                     factor: r * coarse,
                     n_free_dofs: 0,
                     steps: 0,
+                    solver: kappe_fe::LevelSolve::Direct,
                 },
             ],
             0.005,

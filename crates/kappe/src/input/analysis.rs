@@ -205,6 +205,12 @@ pub struct AnalysisOptions {
     /// are always solved). `false`: the split is solved in every state.
     #[serde(default = "default_true")]
     pub blf_sampling: bool,
+    /// Solve the splits of the mesh-error pass with the two-level solver
+    /// (`kappe_fe::twolevel`: PCG and LOBPCG preconditioned by the coarser mesh's LLᵀ, no LLᵀ of
+    /// the split), falling back to the direct solve wherever its guards decline
+    /// (docs/convergence.md, "The `twogrid` branch"). `false` (default): the direct solve.
+    #[serde(default)]
+    pub blf_two_level: bool,
 }
 
 impl Default for AnalysisOptions {
@@ -223,6 +229,7 @@ impl Default for AnalysisOptions {
             blf_tolerance: DEFAULT_BLF_TOLERANCE,
             blf_max_split: default_blf_max_split(),
             blf_sampling: true,
+            blf_two_level: false,
         }
     }
 }

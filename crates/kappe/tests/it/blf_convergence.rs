@@ -53,6 +53,7 @@ fn the_converged_factor_of_an_early_state_is_within_the_tolerance() {
                 factor,
                 n_free_dofs: 0,
                 steps: 0,
+                solver: kappe_fe::LevelSolve::Direct,
             })
             .to_vec(),
         0.005,
