@@ -13,3 +13,4 @@ mod fixtures;
 mod mindlin;
 mod nonlinear;
 mod solver_checks;
+mod twolevel;
