@@ -4,7 +4,9 @@
 //! seconds, the relative difference, the two-level counts and phase seconds.
 //!
 //! `cargo run --release -p fe --example twolevel_mesh -- MESH.json…`; options from the
-//! environment: `BLOCK` (default 1), `SWEEPS` (1), `TL_ETOL` (the two-level's η, default ETOL), `GAP` (0.10), `STOL` (1e-9), `ETOL` (1e-5).
+//! environment (defaults: `TwoLevelOptions::default()`): `BLOCK`, `SWEEPS`, `GAP`, `STOL`;
+//! `ETOL` the direct Lanczos residual (1e-5, as `kappe design`), `TL_ETOL` the two-level η
+//! (default ETOL, as `kappe_fe::converge_from_with` passes it).
 
 use std::time::Instant;
 
@@ -25,13 +27,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sturm_check: false,
         ..Default::default()
     };
+    let d = TwoLevelOptions::default();
     let tl = TwoLevelOptions {
-        block: env("BLOCK", 1),
-        sweeps: env("SWEEPS", 1),
-        gap: env("GAP", 0.10),
-        static_tolerance: env("STOL", 1e-9),
+        block: env("BLOCK", d.block),
+        sweeps: env("SWEEPS", d.sweeps),
+        gap: env("GAP", d.gap),
+        static_tolerance: env("STOL", d.static_tolerance),
         eigen_tolerance: env("TL_ETOL", opts.tolerance),
-        ..TwoLevelOptions::default()
+        ..d
     };
     println!("{tl:?}");
     println!(

@@ -55,6 +55,10 @@ pub struct StateAnalysis {
     /// solved neighbours (`crate::analysis::convergence`; such a state cannot govern).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub blf_interpolated: Option<bool>,
+    /// With `analysis.blf_two_level`, a state solved on the split: how its finest split was
+    /// solved (`two_level`, or `fallback` where the two-level solver declined).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blf_split_solver: Option<super::convergence::SplitMethod>,
     /// All factors found (ascending).
     pub blf_modes: Vec<f64>,
     /// What the buckling analysis did.
@@ -1009,6 +1013,7 @@ fn assemble(
         let (mut blf_mesh, mut blf_error, mut blf_converged, mut blf_split) =
             (None, None, None, None);
         let mut blf_interpolated = None;
+        let mut blf_split_solver = None;
         if let Some(b) = &p.buckling {
             status = b.status;
             modes = b.factors.clone();
@@ -1019,6 +1024,9 @@ fn assemble(
                 blf_error = Some(c.error);
                 blf_converged = Some(c.converged);
                 blf_split = c.levels.last().map(|l| l.split);
+                if options.blf_two_level && !interpolated.contains(&q) {
+                    blf_split_solver = c.levels.last().map(|l| l.solver.into());
+                }
             }
             mechanism = b.mechanism.clone();
             nodes = b.shell_nodes;
@@ -1084,6 +1092,7 @@ fn assemble(
             blf_converged,
             blf_split,
             blf_interpolated,
+            blf_split_solver,
             blf_modes: modes,
             buckling: status,
             max_compression_stress_pa: smin,

@@ -36,7 +36,32 @@
 //! estimate exceeds `blf_tolerance`. A state left interpolated or unconverged therefore cannot
 //! govern the verdict.
 
-use kappe_fe::{ConvergedFactor, MeshLevel};
+use kappe_fe::{ConvergedFactor, LevelSolve, MeshLevel};
+
+/// How a state's finest split was solved, as `summary.json` reports it with
+/// `analysis.blf_two_level` (docs/convergence.md, "The `twogrid` branch").
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum SplitMethod {
+    /// Its own LLᵀ and Lanczos.
+    Direct,
+    /// The two-level solver (`kappe_fe::twolevel`), every guard passed.
+    TwoLevel,
+    /// The two-level solver declined and the split was solved directly.
+    Fallback,
+}
+
+impl From<LevelSolve> for SplitMethod {
+    fn from(s: LevelSolve) -> Self {
+        match s {
+            LevelSolve::Direct => Self::Direct,
+            LevelSolve::TwoLevel => Self::TwoLevel,
+            LevelSolve::Fallback => Self::Fallback,
+        }
+    }
+}
 
 /// The interpolation test of [`sample`] that accepts an interval whatever its states' brackets:
 /// the probes' ratios within this share of the tolerance of the interpolated ones.

@@ -69,6 +69,7 @@ pub use collapse::{
     cap_state_lba_from, collapse_factor, object_as_printed_shift, object_as_printed_shift_cached,
     shifted,
 };
+pub use convergence::SplitMethod;
 pub use graded::{Grading, coarsened_state, graded_rows, graded_state};
 pub use green::{
     CapGreen, ElementLayers, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli,

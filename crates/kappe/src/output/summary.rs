@@ -201,6 +201,10 @@ pub struct StateEntry {
     /// The split mesh's correction was interpolated between solved neighbouring states.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub blf_interpolated: Option<bool>,
+    /// With `analysis.blf_two_level`, a state solved on the split: `two_level`, or `fallback`
+    /// where the two-level solver declined and the split was solved directly.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blf_split_solver: Option<crate::analysis::convergence::SplitMethod>,
     /// What the buckling analysis did (absent without an analysis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub buckling: Option<BucklingStatus>,
@@ -529,6 +533,7 @@ impl Outcome {
                     blf_converged: a.and_then(|a| a.blf_converged),
                     blf_split: a.and_then(|a| a.blf_split),
                     blf_interpolated: a.and_then(|a| a.blf_interpolated),
+                    blf_split_solver: a.and_then(|a| a.blf_split_solver),
                     buckling: a.map(|a| a.buckling),
                     max_overhang_m: a.map(|a| a.max_overhang_m),
                     strength_utilisation: a.and_then(|a| a.strength_utilisation),
