@@ -398,6 +398,9 @@ pub fn split_buckling(
 /// A 6 × 6 block of P (row-major): a split node's DOFs from one coarse node's.
 type Block6 = [[f64; 6]; 6];
 
+/// A split triangle's prolongation: per node, up to two (coarse corner index, block) pairs.
+type ChildQ = [[Option<(usize, Block6)>; 2]; 3];
+
 /// The two meshes, their free DOFs and patterns, and the prolongation.
 struct Levels<'a> {
     coarse: &'a ShellModel,
@@ -409,7 +412,7 @@ struct Levels<'a> {
     geo: Vec<TriangleGeometry>,
     /// Per split triangle and node k: up to two (coarse corner index 0..3, block) pairs, the
     /// block's rows of fixed split DOFs zeroed.
-    q: Vec<[[Option<(usize, Block6)>; 2]; 3]>,
+    q: Vec<ChildQ>,
     /// P by rows (split free DOFs): `p_ptr`, coarse free index, weight.
     p_ptr: Vec<usize>,
     p_col: Vec<usize>,
@@ -449,7 +452,7 @@ fn node_prolongation(
             let (xa, xb) = (coarse.nodes.get(*a)?, coarse.nodes.get(*b)?);
             let d: [f64; 3] = std::array::from_fn(|c| xb[c] - xa[c]);
             let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            if !(l > 0.0) {
+            if l.is_nan() || l <= 0.0 {
                 return None;
             }
             let e = d.map(|c| c / l);
@@ -507,7 +510,7 @@ impl<'a> Levels<'a> {
         let mut q = Vec::with_capacity(fine.triangles.len());
         for (t, tri) in fine.triangles.iter().enumerate() {
             let corners = coarse.triangles[t / CHILDREN];
-            let mut qt: [[Option<(usize, Block6)>; 2]; 3] = [[None; 2]; 3];
+            let mut qt: ChildQ = [[None; 2]; 3];
             for (k, &node) in tri.iter().enumerate() {
                 for (slot, &(c, mut b)) in prol[node].iter().enumerate() {
                     let Some(a) = corners.iter().position(|&x| x == c) else {
@@ -633,7 +636,7 @@ impl<'a> Levels<'a> {
 
 /// `g += Qᵀ k Q`, Q the child's 18 × 18 prolongation from its coarse triangle's corners (per
 /// child node k up to two (corner, 6 × 6 block) pairs).
-fn galerkin_add(g: &mut Mat18, k: &Mat18, q: &[[Option<(usize, Block6)>; 2]; 3]) {
+fn galerkin_add(g: &mut Mat18, k: &Mat18, q: &ChildQ) {
     // T = K Q (18 × 18).
     let mut t = Mat18::zeros();
     for (kn, pairs) in q.iter().enumerate() {
@@ -1075,7 +1078,7 @@ fn rayleigh_ritz(parts: &[&Block], k: usize) -> Option<(Vec<f64>, DMatrix<f64>)>
     let mut order: Vec<usize> = (0..keep.len()).collect();
     order.sort_by(|&a, &b| r.eigenvalues[b].total_cmp(&r.eigenvalues[a]));
     let theta: Vec<f64> = order.iter().take(k).map(|&i| r.eigenvalues[i]).collect();
-    if theta.iter().any(|t| !(*t > 0.0)) {
+    if theta.iter().any(|t| t.is_nan() || *t <= 0.0) {
         return None;
     }
     let mut c = DMatrix::<f64>::zeros(m, k);
