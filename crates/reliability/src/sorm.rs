@@ -126,7 +126,11 @@ pub fn inverse_mills(beta: f64) -> f64 {
 /// β or curvature is [`Error::InvalidOption`].
 pub fn hohenbichler_rackwitz(beta: f64, curvatures: &[f64]) -> Result<f64> {
     check_inputs(beta, curvatures)?;
-    let (b, sign) = if beta > 0.0 { (beta, 1.0) } else { (-beta, -1.0) };
+    let (b, sign) = if beta > 0.0 {
+        (beta, 1.0)
+    } else {
+        (-beta, -1.0)
+    };
     let psi = inverse_mills(b);
     let mut product = 1.0;
     for (index, &k) in curvatures.iter().enumerate() {
@@ -150,7 +154,11 @@ pub fn hohenbichler_rackwitz(beta: f64, curvatures: &[f64]) -> Result<f64> {
 /// [`hohenbichler_rackwitz`]); None where a factor is ≤ 0 or β, κ are not finite.
 pub fn breitung(beta: f64, curvatures: &[f64]) -> Option<f64> {
     check_inputs(beta, curvatures).ok()?;
-    let (b, sign) = if beta > 0.0 { (beta, 1.0) } else { (-beta, -1.0) };
+    let (b, sign) = if beta > 0.0 {
+        (beta, 1.0)
+    } else {
+        (-beta, -1.0)
+    };
     let mut product = 1.0;
     for &k in curvatures {
         let factor = 1.0 + b * sign * k;

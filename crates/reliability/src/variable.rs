@@ -162,9 +162,7 @@ impl Distribution {
     pub fn d2x_dz2(&self, z: f64) -> f64 {
         match *self {
             Distribution::Normal { .. } => 0.0,
-            Distribution::Lognormal { lambda, zeta, .. } => {
-                zeta * zeta * (lambda + zeta * z).exp()
-            }
+            Distribution::Lognormal { lambda, zeta, .. } => zeta * zeta * (lambda + zeta * z).exp(),
             Distribution::Uniform { lower, upper } => -(upper - lower) * z * stdnormal::pdf(z),
         }
     }

@@ -47,7 +47,11 @@ fn sorm_equals_form_for_a_linear_limit_state() {
     let mut plain = |x: &[f64]| 10.0 + 3.0 * x[0] - 2.0 * x[1];
     let s = sorm(&model, &mut plain, &f, &SormOptions::default()).unwrap();
     assert_eq!(s.hessian, HessianSource::ValueDifferences);
-    assert!(s.curvatures.iter().all(|k| k.abs() < 1e-7), "{:?}", s.curvatures);
+    assert!(
+        s.curvatures.iter().all(|k| k.abs() < 1e-7),
+        "{:?}",
+        s.curvatures
+    );
     assert!((s.pf / f.pf - 1.0).abs() < 1e-7, "{} vs {}", s.pf, f.pf);
 }
 
@@ -97,7 +101,10 @@ fn paraboloids_against_their_exact_pf() {
             // Breitung (its first-order term (ψ − β)κ/2(1 + βκ) is what it removes).
             if kappa > 0.0 {
                 let b = s.pf_breitung.unwrap() / exact - 1.0;
-                assert!(err.abs() < b.abs(), "β {beta}, κ {kappa}: {err} vs Breitung {b}");
+                assert!(
+                    err.abs() < b.abs(),
+                    "β {beta}, κ {kappa}: {err} vs Breitung {b}"
+                );
             }
         }
     }
@@ -266,7 +273,12 @@ fn hessian_through_the_transform_matches_finite_differences() {
     assert_eq!(a.hessian, HessianSource::LimitState);
     assert_eq!(b.hessian, HessianSource::ValueDifferences);
     for (x, y) in a.curvatures.iter().zip(&b.curvatures) {
-        assert!((x - y).abs() < 1e-4, "{:?} vs {:?}", a.curvatures, b.curvatures);
+        assert!(
+            (x - y).abs() < 1e-4,
+            "{:?} vs {:?}",
+            a.curvatures,
+            b.curvatures
+        );
     }
     assert!((a.pf / b.pf - 1.0).abs() < 1e-4, "{} vs {}", a.pf, b.pf);
 }
@@ -297,7 +309,10 @@ fn invalid_curvatures_are_named_errors() {
     ));
     // β ≤ 0: the safe domain's formula, P_f = 1 − Φ(β)∏(1 − ψ(−β)κ)^(−1/2); with κ = 0 it is
     // Φ(−β) exactly, and it is continuous through β = 0 to first order in κ.
-    assert_eq!(hohenbichler_rackwitz(-1.0, &[0.0]).unwrap(), stdnormal::cdf(1.0));
+    assert_eq!(
+        hohenbichler_rackwitz(-1.0, &[0.0]).unwrap(),
+        stdnormal::cdf(1.0)
+    );
     let (below, above) = (
         hohenbichler_rackwitz(-1e-9, &[0.01]).unwrap(),
         hohenbichler_rackwitz(1e-9, &[0.01]).unwrap(),
