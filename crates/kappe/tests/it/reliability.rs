@@ -965,7 +965,10 @@ fn form_of_the_strength_components_agrees_with_monte_carlo() {
     assert!(
         results.iter().any(|(n, _, _)| *n == "strength") && results.len() > 2,
         "components: {:?}",
-        results.iter().map(|(n, r, _)| (n, r.beta)).collect::<Vec<_>>()
+        results
+            .iter()
+            .map(|(n, r, _)| (n, r.beta))
+            .collect::<Vec<_>>()
     );
     let field = GreenField::solve(&cap, &du.analysis, &green.schedule, last)
         .unwrap()

@@ -12,7 +12,7 @@ use kappe_reliability::{
 fn standard(n: usize) -> Model {
     Model::independent(
         (0..n)
-            .map(|i| RandomVariable::normal(&format!("u{i}"), 0.0, 1.0).unwrap())
+            .map(|i| RandomVariable::normal(format!("u{i}"), 0.0, 1.0).unwrap())
             .collect(),
     )
     .unwrap()
