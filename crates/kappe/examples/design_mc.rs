@@ -49,7 +49,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rows = std::env::args().nth(2).unwrap_or_else(|| "13".into());
     println!(
         "row | method | N | FORM P_f | MC P_f | 95 % interval | FORM inside | governing states | \
-         excluded share | table solves | re-solved samples | centres | FORM s | MC s | run CPU s | load"
+         excluded share | table solves | re-solved samples | centres | FORM s | MC s | run CPU s | \
+         SORM P_f | SORM inside | load"
     );
     let mut cases = Vec::new();
     if rows.contains('1') {
@@ -77,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let r = out.reliability.as_ref().ok_or("no reliability")?;
         let mc = r.monte_carlo.as_ref().ok_or("no Monte Carlo")?;
         println!(
-            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {}",
+            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.4e} | {:?} | {}",
             mc.samples,
             r.pf,
             mc.pf,
@@ -93,6 +94,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.seconds,
             mc.seconds,
             cpu,
+            mc.sorm_pf.unwrap_or(f64::NAN),
+            mc.sorm_in_interval,
             load_average()
         );
     }

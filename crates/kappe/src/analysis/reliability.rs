@@ -153,6 +153,8 @@ pub struct ComponentSorm {
     /// Why the component keeps FORM's P_f (None: SORM's): [`FORM_ONLY_FIRST_ORDER`],
     /// [`FORM_ONLY_NO_HESSIAN`], [`FORM_ONLY_CURVATURE`], [`FORM_ONLY_FAILED`].
     pub form_only: Option<&'static str>,
+    /// Seconds SORM took for this component (its Hessian and curvatures).
+    pub seconds: f64,
 }
 
 /// A screened component (first-order β₁ at the means, no design point to take curvatures at):
@@ -174,6 +176,7 @@ impl ComponentSorm {
             pf: r.pf,
             beta: r.beta,
             form_only: Some(why),
+            seconds: 0.0,
         }
     }
 
@@ -184,11 +187,24 @@ impl ComponentSorm {
                 pf: s.pf,
                 beta: if s.beta.is_finite() { s.beta } else { r.beta },
                 form_only: None,
+                seconds: 0.0,
             },
             Err(kappe_reliability::Error::SormCurvature { .. }) => {
                 Self::form_only(r, FORM_ONLY_CURVATURE)
             }
             Err(_) => Self::form_only(r, FORM_ONLY_FAILED),
+        }
+    }
+
+    /// [`Self::of`] with the seconds since `t0`.
+    fn timed(
+        s: Result<SormResult, kappe_reliability::Error>,
+        r: &FormResult,
+        t0: kappe_fe::clock::Instant,
+    ) -> Self {
+        ComponentSorm {
+            seconds: t0.elapsed().as_secs_f64(),
+            ..Self::of(s, r)
         }
     }
 
@@ -219,6 +235,10 @@ pub struct SormSystem {
     /// an evaluation failed). Absent when every component has its SORM P_f.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub form_only: BTreeMap<String, usize>,
+    /// Seconds SORM added, summed over the components (on whichever thread each ran) and the
+    /// print's second series system; the states' second systems (4 000 samples of a few
+    /// components each) are not counted.
+    pub seconds: f64,
 }
 
 /// One parameter's share in the governing check.
@@ -873,6 +893,7 @@ impl ReducedBuckling {
 /// [`FORM_ONLY_NO_HESSIAN`], where the reduction does not hold or its last two re-solves are
 /// not two distinct points ending at the design point.
 pub fn time_buckling_sorm(model: &Model, g: &TimeBuckling<'_>, r: &FormResult) -> ComponentSorm {
+    let t0 = kappe_fe::clock::Instant::now();
     let no_hessian = || ComponentSorm::form_only(r, FORM_ONLY_NO_HESSIAN);
     let Some(shell0) = g.shell0 else {
         return no_hessian();
@@ -915,9 +936,10 @@ pub fn time_buckling_sorm(model: &Model, g: &TimeBuckling<'_>, r: &FormResult) -
     let mut ls = kappe_reliability::WithHessian(|x: &[f64], grad: &mut [f64], hess: &mut [f64]| {
         reduced.ln_hessian(x, grad, hess)
     });
-    ComponentSorm::of(
+    ComponentSorm::timed(
         kappe_reliability::sorm(model, &mut ls, r, &SormOptions::default()),
         r,
+        t0,
     )
 }
 
@@ -1862,9 +1884,11 @@ fn form_checks_with<'a>(
             }
             Err(e) => return Err(e),
         };
-        let s = ComponentSorm::of(
+        let t0 = kappe_fe::clock::Instant::now();
+        let s = ComponentSorm::timed(
             kappe_reliability::sorm(model, g.as_mut(), &r, &SormOptions::default()),
             &r,
+            t0,
         );
         // Several components of one check (e.g. a buildability object's layers): the
         // weakest one's β.
@@ -2066,6 +2090,7 @@ pub fn print_reliability(
     let Some((gov_state, gov_check, gov, _)) = results.get(sys.governing) else {
         return Err(rel_err(kappe_reliability::Error::NoComponents));
     };
+    let t_sorm = kappe_fe::clock::Instant::now();
     let with_sorm: Vec<Component> = results.iter().map(|(_, _, r, s)| s.component(r)).collect();
     let sorm_sys = series_system(&with_sorm, system).map_err(rel_err)?;
     let mut form_only = BTreeMap::new();
@@ -2081,6 +2106,8 @@ pub fn print_reliability(
             governing_state: *state,
             governing_check: (*check).to_owned(),
             form_only,
+            seconds: t_sorm.elapsed().as_secs_f64()
+                + results.iter().map(|(_, _, _, s)| s.seconds).sum::<f64>(),
         });
     let names = &gov.names;
     let design_point = names.iter().cloned().zip(gov.x_star.clone()).collect();
