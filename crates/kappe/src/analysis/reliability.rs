@@ -885,14 +885,29 @@ impl ReducedBuckling {
     }
 }
 
+/// Largest distance h in y = ln(Ė/E₀) between the design point's re-solve and the one before
+/// it for the Hermite cubic's L″ at the design point (truncation ≈ h²L⁗/12: ≈ 3·10⁻⁵·L⁗ at
+/// h = 0.02); the smallest is a tenth of it (the noise of the re-solves' L′, ≈ 10⁻⁸ by the
+/// Lanczos residual, enters L″ as 2·10⁻⁸/h: ≤ 10⁻⁵ there). Outside that band one more
+/// re-solve at y* + SORM_Y_STEP takes the other end. Measured on study No. 14's cap
+/// (every-8th-row shell): with the last two re-solves as FORM left them (often within 10⁻⁶ of
+/// each other in y, near convergence) L″ moved β by up to 0.06 and rejected one state's
+/// curvature (docs/reliability.md, "SORM").
+pub const SORM_Y_STEP: f64 = 0.02;
+
 /// SORM of a [`TimeBuckling`] component at its FORM result `r` (module docs, "SORM"), through
-/// the 1-D reduction: L = ln Λ is the Hermite cubic through the component's last two re-solves,
-/// the last at the design point, so L and L′ there are the re-solve's own and L″ is the
-/// cubic's (error ≈ h²L⁗/12 for re-solves h apart in y; no extra eigensolve), and the Hessian
-/// of G = ln(BLF/BLF_min) is closed-form ([`ReducedBuckling::ln_hessian`]). FORM's P_f, flagged
-/// [`FORM_ONLY_NO_HESSIAN`], where the reduction does not hold or its last two re-solves are
-/// not two distinct points ending at the design point.
-pub fn time_buckling_sorm(model: &Model, g: &TimeBuckling<'_>, r: &FormResult) -> ComponentSorm {
+/// the 1-D reduction: L = ln Λ is the Hermite cubic through the design point's re-solve and a
+/// re-solve 0.1–1 × [`SORM_Y_STEP`] from it in y (the one before it when there, else one more
+/// re-solve at y* + SORM_Y_STEP), so L and L′ there are the re-solve's own and L″ is the
+/// cubic's, and the Hessian of G = ln(BLF/BLF_min) is closed-form
+/// ([`ReducedBuckling::ln_hessian`]). FORM's P_f, flagged [`FORM_ONLY_NO_HESSIAN`], where the
+/// reduction does not hold, the last re-solve is not at the design point, or the extra
+/// re-solve fails.
+pub fn time_buckling_sorm(
+    model: &Model,
+    g: &mut TimeBuckling<'_>,
+    r: &FormResult,
+) -> ComponentSorm {
     let t0 = kappe_fe::clock::Instant::now();
     let no_hessian = || ComponentSorm::form_only(r, FORM_ONLY_NO_HESSIAN);
     let Some(shell0) = g.shell0 else {
@@ -907,6 +922,34 @@ pub fn time_buckling_sorm(model: &Model, g: &TimeBuckling<'_>, r: &FormResult) -
         i.and_then(|i| r.x_star.get(i).copied()).unwrap_or(nominal)
     };
     let (e_star, rate_star) = (at(v.e0t, e00), at(v.rate, rate0));
+    let y = |s: &[f64; 4]| (s[1] / s[0]).ln();
+    let far = match g.solves.as_slice() {
+        [.., a, b] => !(0.1 * SORM_Y_STEP..=SORM_Y_STEP).contains(&(y(b) - y(a)).abs()),
+        _ => true,
+    };
+    if far {
+        // One more re-solve at y* + SORM_Y_STEP: Ė × e^h where Ė is random, else E₀ × e^−h.
+        use kappe_reliability::LimitState;
+        let mut x = r.x_star.clone();
+        let moved = match (v.rate, v.e0t) {
+            (Some(i), _) => x.get_mut(i).map(|e| *e *= SORM_Y_STEP.exp()),
+            (None, Some(i)) => x.get_mut(i).map(|e| *e *= (-SORM_Y_STEP).exp()),
+            (None, None) => None,
+        };
+        if moved.is_none() || g.value(&x).is_err() {
+            return no_hessian();
+        }
+        // The cubic runs from the extra point to the design point's (`b` last).
+        if let Some(star) = g
+            .solves
+            .iter()
+            .rev()
+            .find(|s| s[0] == e_star && s[1] == rate_star)
+            .copied()
+        {
+            g.solves.push(star);
+        }
+    }
     let last: Vec<&[f64; 4]> = g.solves.iter().rev().take(2).rev().collect();
     let &[a, b] = last.as_slice() else {
         return no_hessian();
@@ -1546,7 +1589,7 @@ fn state_form_with<'a>(
         };
         if let Some(mut g) = time_buckling {
             if let Some(r) = time_form(&state_model, g.as_mut()).map_err(rel_err)? {
-                let s = time_buckling_sorm(&state_model, &g, &r);
+                let s = time_buckling_sorm(&state_model, &mut g, &r);
                 given.push((check.name(), r, s));
             }
             continue;

@@ -541,7 +541,7 @@ fn sorm_of_a_time_parameter_state_agrees_with_monte_carlo() {
         None,
     );
     let r = kappe::analysis::time_buckling_form(&dm, &mut g).unwrap();
-    let reduced = kappe::analysis::time_buckling_sorm(&dm, &g, &r);
+    let reduced = kappe::analysis::time_buckling_sorm(&dm, &mut g, &r);
     let fd = kappe_reliability::sorm(&dm, &mut g, &r, &Default::default()).unwrap();
     assert_eq!(
         fd.hessian,
@@ -1183,4 +1183,66 @@ fn reduced_form_equals_form_on_default_cap_states() {
         full += r.solves_form;
     }
     assert!(reduced < full, "{reduced} re-solves vs FORM's {full}");
+}
+
+/// Every time buckling component of study No. 14's cap with E₀, Ė and γ uncertain and E₀
+/// drifting −20 %/h (form_cost's first row, screening off): SORM through the 1-D reduction
+/// against SORM with the Hessian by differences of the re-solves' exact gradient (2n more
+/// re-solves), printed per state with the reason where FORM's P_f is kept. A measurement for
+/// docs/reliability.md ("SORM"), not a check: `cargo test --release -p kappe --test it
+/// sorm_of_every_time_buckling_component -- --ignored --nocapture`.
+#[test]
+#[ignore = "a measurement: about a minute of re-solves"]
+fn sorm_of_every_time_buckling_component() {
+    let mut d = study14(Some(-20.0));
+    let u = with_uncertainty(
+        "[material.time]\nmodel = \"linear\"\nyoungs_modulus = 1.3e6\nyoungs_modulus_rate = 400.0\n\
+         [uncertainty]\n\"material.time.youngs_modulus\" = { dist = \"lognormal\", cov = 0.15 }\n\
+         \"material.time.youngs_modulus_rate\" = { dist = \"lognormal\", cov = 0.3 }\n\
+         \"material.specific_weight\" = { dist = \"normal\", cov = 0.05 }\n\
+         [uncertainty.drift]\n\"material.time.youngs_modulus\" = { percent_per_hour = -20.0 }\n",
+    )
+    .unwrap();
+    d.uncertainty = u.uncertainty;
+    d.analysis.row_stride = 8;
+    let cap = design_cap(&d, kappe::Context::default()).unwrap();
+    let green = kappe::analysis::CapGreen::new(&cap).unwrap();
+    let (model, drifts, v) = prepare(&cap).unwrap().unwrap();
+    let time = d.time_model().unwrap();
+    eprintln!(
+        "state | FORM β | SORM β (reduction) | reason | SORM β (differences) | κ (differences)"
+    );
+    for q in (0..cap.states.len()).rev().take(12) {
+        let t_hours = green.schedule.layers[q].end_s / 3600.0;
+        let dm = model.drifted(&drifts, t_hours).unwrap();
+        let Some((blf0, _)) =
+            kappe::analysis::time_state_blf(&cap, &d.analysis, &green.schedule, &time, q, 1e-10)
+                .unwrap()
+        else {
+            continue;
+        };
+        let mut g = kappe::analysis::TimeBuckling::new(
+            (&cap, &d.analysis, &green.schedule),
+            time.clone(),
+            v,
+            (blf0, 0.0, q),
+            d.constraints.blf_min,
+            None,
+        );
+        let Ok(r) = kappe::analysis::time_buckling_form(&dm, &mut g) else {
+            continue;
+        };
+        let reduced = kappe::analysis::time_buckling_sorm(&dm, &mut g, &r);
+        let fd = kappe_reliability::sorm(&dm, &mut g, &r, &Default::default());
+        eprintln!(
+            "{q} | {:.4} | {:.4} | {:?} | {:?} | {:?}",
+            r.beta,
+            reduced.beta,
+            reduced.form_only,
+            fd.as_ref().map(|s| s.beta).ok(),
+            fd.as_ref()
+                .map(|s| s.curvatures.clone())
+                .map_err(|e| e.to_string())
+        );
+    }
 }
