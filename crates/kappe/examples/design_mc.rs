@@ -1,6 +1,7 @@
 //! The Monte Carlo of a design's governing states against FORM (issue 24: "on the default cap
 //! … FORM P_f against Monte Carlo with ≥ 10⁴ samples"), printed as a table:
-//! `cargo run --release -p kappe --example design_mc -- [samples] [rows]`.
+//! `cargo run --release -p kappe --example design_mc -- [samples] [rows]` (samples 0: the runs
+//! with FORM and SORM only, no sampling).
 //!
 //! Rows: `1` study No. 14's small cap (E₀ lognormal cov 0.15, γ normal cov 0.05, E₀ drifting
 //! −12 %/h; print P_f ≈ 2e-2), crude and importance sampling; `3` the default cap with
@@ -35,8 +36,14 @@ fn design(
     samples: u64,
     method: &str,
 ) -> Result<Design, kappe::DesignError> {
+    // N = 0: the run with FORM and SORM only (seed 1 as the sampled rows), no sampling.
+    let mc = if samples == 0 {
+        String::new()
+    } else {
+        format!("monte_carlo = {samples}\nmonte_carlo_method = \"{method}\"\n")
+    };
     Design::from_toml_str(&format!(
-        "{base}monte_carlo = {samples}\nmonte_carlo_method = \"{method}\"\nseed = 1\n\
+        "{base}{mc}seed = 1\n\
          [uncertainty.drift]\n\"material.time.youngs_modulus\" = {{ percent_per_hour = {drift:?} }}\n"
     ))
 }
@@ -49,7 +56,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let rows = std::env::args().nth(2).unwrap_or_else(|| "13".into());
     println!(
         "row | method | N | FORM P_f | MC P_f | 95 % interval | FORM inside | governing states | \
-         excluded share | table solves | re-solved samples | centres | FORM s | MC s | run CPU s | load"
+         excluded share | table solves | re-solved samples | centres | FORM s | MC s | run CPU s | \
+         SORM P_f | SORM inside | load"
     );
     let mut cases = Vec::new();
     if rows.contains('1') {
@@ -75,9 +83,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let out = run(&d, &Options::of(&d), &no_progress)?;
         let cpu = cpu_seconds().unwrap_or(f64::NAN) - c0;
         let r = out.reliability.as_ref().ok_or("no reliability")?;
+        if samples == 0 {
+            println!(
+                "{name} | FORM P_f {:.4e} | SORM P_f {:?} (FORM-only components {:?}) | FORM s {:.1} | \
+                 run CPU s {cpu:.1} | {}",
+                r.pf,
+                r.sorm.as_ref().map(|s| s.pf),
+                r.sorm.as_ref().map(|s| &s.form_only),
+                r.seconds,
+                load_average()
+            );
+            continue;
+        }
         let mc = r.monte_carlo.as_ref().ok_or("no Monte Carlo")?;
         println!(
-            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {}",
+            "{name} | {method} | {} | {:.4e} | {:.4e} | [{:.4e}, {:.4e}] | {} | {} {:?} | {:.1e} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.4e} | {:?} | {}",
             mc.samples,
             r.pf,
             mc.pf,
@@ -93,6 +113,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.seconds,
             mc.seconds,
             cpu,
+            mc.sorm_pf.unwrap_or(f64::NAN),
+            mc.sorm_in_interval,
             load_average()
         );
     }

@@ -79,7 +79,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or(2);
     println!(
         "row | det. analysis wall s | nominal run CPU s | reliability wall s | CPU s | \
-         ratio wall | ratio CPU | components | screened states | print β | print P_f | load"
+         ratio wall | ratio CPU | components | screened states | print β | print P_f | \
+         SORM β / P_f | SORM thread-s | FORM-only components | load"
     );
     // `form_cost [repeats] [rows]`: rows a list of 1 (study No. 14, time parameters), 2 (+
     // strength, speed), 3 (the default cap, time parameters); default all.
@@ -201,7 +202,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
         println!(
             "{name} | {dw:.2} | {dc:.2} | {rw:.2} | {rc:.2} | {:.2} | {:.2} | {} | {} of {} | {:.4} | \
-             {:.4e} | {}",
+             {:.4e} | {} | {:.3} | {:?} | {}",
             rw / dw,
             rc / dc,
             r.components,
@@ -209,6 +210,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             r.states.len(),
             r.beta,
             r.pf,
+            r.sorm
+                .as_ref()
+                .map_or(String::new(), |s| format!("{:.4} / {:.4e}", s.beta, s.pf)),
+            r.sorm.as_ref().map_or(f64::NAN, |s| s.seconds),
+            r.sorm.as_ref().map(|s| &s.form_only),
             load_average()
         );
     }

@@ -317,8 +317,11 @@ fn after_form(
             tracking: moving.as_ref().map(|m| &m.tracking),
         },
     );
+    // SORM's β where there is one (`Reliability::verdict`): the better estimate of the print's
+    // P_f; FORM's stays in the summary.
     if let Some(r) = &reliability
-        && r.beta < r.beta_min
+        && let (beta, gov_state, gov_check) = r.verdict()
+        && beta < r.beta_min
     {
         // After the structural constraints, before the robot's failures.
         let at = verdict
@@ -330,11 +333,11 @@ fn after_form(
             at,
             crate::verdict::Failure::Constraint {
                 name: "beta_min".into(),
-                worst: Some(r.beta),
+                worst: Some(beta),
                 limit: r.beta_min,
                 unit: "1".into(),
-                state: Some(r.governing_state),
-                element: r.governing_check.clone(),
+                state: Some(gov_state),
+                element: gov_check.to_owned(),
             },
         );
         verdict.ok = false;

@@ -154,6 +154,19 @@ pub enum Error {
         u_residual: f64,
         u_tolerance: f64,
     },
+    /// A principal curvature for which the second-order formula does not hold.
+    #[error(
+        "SORM: principal curvature κ{index} = {curvature} at β = {beta} gives the factor \
+         1 + ψ(β)κ = {factor} ≤ 0; the formula needs κ > {bound} (the surface bends towards the \
+         origin so strongly that its paraboloid encloses it); use sampling for this limit state"
+    )]
+    SormCurvature {
+        index: usize,
+        curvature: f64,
+        beta: f64,
+        factor: f64,
+        bound: f64,
+    },
     /// A series system without components.
     #[error("the series system has no components; at least one is needed")]
     NoComponents,

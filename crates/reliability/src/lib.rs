@@ -12,6 +12,8 @@
 //!   importance factors and dβ/dμ, dβ/dσ.
 //! * [`system`]: a series system of many FORM components (every state × every check), with
 //!   ρᵢⱼ = αᵢᵀαⱼ: P_f,sys by seeded importance sampling of the union, and Ditlevsen bounds.
+//! * [`mod@sorm`]: SORM at FORM's design point: the principal curvatures of the limit-state
+//!   surface and P_f by Hohenbichler–Rackwitz (Breitung's formula alongside).
 //! * [`sampling`]: crude Monte Carlo and importance sampling around the design point, seeded,
 //!   splittable into batches that merge bit for bit into the single run.
 //!
@@ -37,6 +39,7 @@ pub mod limit_state;
 pub mod model;
 mod rng;
 pub mod sampling;
+pub mod sorm;
 pub mod spec;
 pub mod stdnormal;
 pub mod system;
@@ -45,13 +48,14 @@ pub mod variable;
 pub use drift::{Drift, DriftStep};
 pub use error::{Error, EvalError, Result};
 pub use form::{FormOptions, FormResult, form, form_at};
-pub use limit_state::{Fallible, LimitState, WithGradient};
+pub use limit_state::{Fallible, LimitState, WithGradient, WithHessian};
 pub use model::{Correlation, Model};
 pub use sampling::{
     Batch, BlockSums, EventBatch, EventBlock, SamplingBatch, SamplingMethod, SamplingOptions,
     SamplingResult, importance_sampling, merge, merge_events, monte_carlo, sample_batch,
     sample_batch_parallel, sample_events,
 };
+pub use sorm::{HessianSource, SormOptions, SormResult, sorm};
 pub use spec::{DistKind, UncertaintySpec};
 pub use system::{Component, SystemOptions, SystemResult, series_system};
 pub use variable::{Distribution, RandomVariable};

@@ -240,6 +240,41 @@ impl Model {
         self.mul_lt(&scaled)
     }
 
+    /// The Hessian of G(u) = g(x(u)) in standard normal space (n×n, row-major) from ∂g/∂x and
+    /// ∂²g/∂x∂xᵀ at the point u, by the chain rule through xᵢ = Fᵢ⁻¹(Φ(zᵢ)), z = Lu:
+    ///
+    /// ∂²G/∂u∂uᵀ = Lᵀ (D H_x D + diag(x″ᵢ ∂g/∂xᵢ)) L,  D = diag(dxᵢ/dzᵢ), x″ᵢ = d²xᵢ/dzᵢ²
+    ///
+    /// (each xᵢ depends on zᵢ alone, and z is linear in u).
+    pub fn hessian_to_standard(&self, u: &[f64], grad_x: &[f64], hess_x: &[f64]) -> Vec<f64> {
+        let n = self.len();
+        let z = self.z_from_u(u);
+        let d: Vec<f64> = (0..n)
+            .map(|i| self.variables[i].distribution.dx_dz(z[i]))
+            .collect();
+        let mut m = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                m[i * n + j] = d[i] * d[j] * hess_x[i * n + j];
+            }
+            m[i * n + i] += self.variables[i].distribution.d2x_dz2(z[i]) * grad_x[i];
+        }
+        // Lᵀ M L with L lower triangular: (Lᵀ M L)_ab = Σ_{i ≥ a} Σ_{j ≥ b} L_ia M_ij L_jb.
+        let mut ml = vec![0.0; n * n];
+        for i in 0..n {
+            for b in 0..n {
+                ml[i * n + b] = (b..n).map(|j| m[i * n + j] * self.chol[j * n + b]).sum();
+            }
+        }
+        let mut h = vec![0.0; n * n];
+        for a in 0..n {
+            for b in 0..n {
+                h[a * n + b] = (a..n).map(|i| self.chol[i * n + a] * ml[i * n + b]).sum();
+            }
+        }
+        h
+    }
+
     /// The model of one print state: variable i scaled by `factors[i]` > 0 (drift factors, see
     /// [`crate::drift`]). Scaling keeps each zᵢ, so the correlation, R₀ and L are unchanged and the
     /// states share one u-space (which a series system over the states needs).

@@ -157,6 +157,16 @@ impl Distribution {
         }
     }
 
+    /// d²x/dz² at z: 0 (normal), ζ²x (lognormal), −(b − a)zφ(z) (uniform, φ′(z) = −zφ(z)).
+    /// SORM's chain rule of the Hessian through the map ([`crate::sorm`]).
+    pub fn d2x_dz2(&self, z: f64) -> f64 {
+        match *self {
+            Distribution::Normal { .. } => 0.0,
+            Distribution::Lognormal { lambda, zeta, .. } => zeta * zeta * (lambda + zeta * z).exp(),
+            Distribution::Uniform { lower, upper } => -(upper - lower) * z * stdnormal::pdf(z),
+        }
+    }
+
     /// The same kind of distribution with another mean and std (uniform: a = μ − √3σ,
     /// b = μ + √3σ). Used for the sensitivities dβ/dμ, dβ/dσ; parameters are not re-validated.
     pub(crate) fn with_mean_std(&self, mean: f64, std: f64) -> Distribution {

@@ -96,6 +96,12 @@ pub struct DesignMonteCarlo {
     pub form_pf: f64,
     /// Whether FORM's P_f lies in the interval.
     pub form_in_interval: bool,
+    /// SORM's P_f of the print (`reliability.sorm.pf`), to compare (absent without it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sorm_pf: Option<f64>,
+    /// Whether SORM's P_f lies in the interval.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sorm_in_interval: Option<bool>,
     /// The governing states sampled.
     pub states: Vec<usize>,
     /// Bound of the share of the print's FORM P_f held by the states left out.
@@ -211,6 +217,9 @@ pub struct McPlan {
     /// The print's FORM P_f.
     #[serde(with = "bits::one")]
     pub form_pf: f64,
+    /// The print's SORM P_f (compared only, never sampled with: plain JSON is enough).
+    #[serde(default)]
+    pub sorm_pf: Option<f64>,
     /// Bound of the left-out states' share of it.
     #[serde(with = "bits::one")]
     pub excluded_share: f64,
@@ -428,6 +437,7 @@ pub fn plan(
         samples,
         seed,
         form_pf: r.pf,
+        sorm_pf: r.sorm.as_ref().map(|s| s.pf),
         excluded_share: if r.pf > 0.0 { excluded / r.pf } else { 0.0 },
         states,
     })
@@ -1043,6 +1053,10 @@ pub fn merge(setup: &McSetup, batches: &[McBatch]) -> Result<DesignMonteCarlo, D
         failures: r.failures,
         form_pf: plan.form_pf,
         form_in_interval: plan.form_pf >= r.interval[0] && plan.form_pf <= r.interval[1],
+        sorm_pf: plan.sorm_pf,
+        sorm_in_interval: plan
+            .sorm_pf
+            .map(|p| p >= r.interval[0] && p <= r.interval[1]),
         states: plan.states.iter().map(|s| s.index).collect(),
         excluded_share: plan.excluded_share,
         tables: setup.tables.iter().filter(|t| !t.exact).count(),

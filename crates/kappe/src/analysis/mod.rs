@@ -74,8 +74,9 @@ pub use green::{
     CapGreen, ElementLayers, FailureMode, GreenOptions, WorstElement, check_state, set_aged_moduli,
 };
 pub use reliability::{
-    Check, GreenField, ReducedAgainstForm, SCREEN_DELTA_RATIO, SCREEN_SAFETY, SCREEN_SHARE, Vars,
-    check_form, first_order_against_form, limit_state, prepare, reduced_against_form, reliability,
-    scaled_ages, screen_delta, state_form,
+    Check, ComponentSorm, GreenField, ReducedAgainstForm, SCREEN_DELTA_RATIO, SCREEN_SAFETY,
+    SCREEN_SHARE, SormSystem, StateForm, StateReliability, TimeBuckling, Vars, check_form,
+    first_order_against_form, limit_state, prepare, reduced_against_form, reliability, scaled_ages,
+    screen_delta, state_form, time_buckling_form, time_buckling_sorm,
 };
 pub use shell::{StateShell, state_shell};

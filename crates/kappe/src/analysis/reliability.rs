@@ -48,12 +48,28 @@
 //! last two re-solves, and the shell is re-solved only at the design points the model proposes,
 //! until one meets FORM's own tolerances with the true g and gradient ([`time_buckling_form`];
 //! docs/reliability.md, "The 1-D reduction").
+//!
+//! # SORM
+//!
+//! Every component also gets its second-order P_f at FORM's design point
+//! ([`kappe_reliability::sorm`]: principal curvatures, Hohenbichler–Rackwitz), [`ComponentSorm`]:
+//! the closed-form components (γ, E, ν scalings; stresses; strength and sliding layers) with
+//! the Hessian by central differences in u (they cost microseconds); the time buckling
+//! components through the 1-D reduction, whose Hermite cubic of ln Λ gives L″ at the design
+//! point without another eigensolve ([`time_buckling_sorm`]). Where SORM does not apply the
+//! component keeps FORM's P_f and says why (`ComponentSorm::form_only`, counted in
+//! [`SormSystem::form_only`]): a screened component (no design point), a time buckling
+//! component outside the reduction (a Hessian would cost 2n re-solves), 1 + ψκ ≤ 0, a failed
+//! evaluation. The state's and the print's series systems are re-run with each component's
+//! equivalent β = −Φ⁻¹(P_f,SORM) and FORM's α (the same sampler and seed), giving
+//! `beta_sorm`/`pf_sorm` per state and [`Reliability::sorm`]; the `beta_min` verdict and
+//! `kappe schedule`'s β target judge SORM's β ([`Reliability::verdict`]).
 
 use std::collections::BTreeMap;
 
 use kappe_reliability::{
-    Component, Drift, FormOptions, FormResult, Model, SystemOptions, WithGradient, form,
-    series_system,
+    Component, Drift, FormOptions, FormResult, Model, SormOptions, SormResult, SystemOptions,
+    WithGradient, form, series_system,
 };
 use serde::{Deserialize, Serialize};
 
@@ -116,6 +132,113 @@ pub struct StateReliability {
     /// [`SCREEN_SHARE`] of it (module docs, "Screening"). Absent when false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub beta_first_order: bool,
+    /// β of the state's series system with every component's SORM P_f (its equivalent
+    /// β = −Φ⁻¹(P_f,SORM), FORM's α): module docs, "SORM". Absent where the state has no
+    /// component.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_sorm: Option<f64>,
+    /// P_f of that system.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pf_sorm: Option<f64>,
+}
+
+/// SORM of one component (module docs, "SORM"): its P_f by Hohenbichler–Rackwitz at FORM's
+/// design point, or FORM's own P_f where SORM does not apply, with the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComponentSorm {
+    /// P_f,SORM (FORM's where `form_only`).
+    pub pf: f64,
+    /// The equivalent β = −Φ⁻¹(P_f,SORM) (FORM's β where that is not finite: P_f underflows).
+    pub beta: f64,
+    /// Why the component keeps FORM's P_f (None: SORM's): [`FORM_ONLY_FIRST_ORDER`],
+    /// [`FORM_ONLY_NO_HESSIAN`], [`FORM_ONLY_CURVATURE`], [`FORM_ONLY_FAILED`].
+    pub form_only: Option<&'static str>,
+    /// Seconds SORM took for this component (its Hessian and curvatures).
+    pub seconds: f64,
+}
+
+/// A screened component (first-order β₁ at the means, no design point to take curvatures at):
+/// its share of the print's P_f is below [`SCREEN_SHARE`] anyway.
+pub const FORM_ONLY_FIRST_ORDER: &str = "first_order";
+/// A time buckling component outside the 1-D reduction (the print speed uncertain, a modulus
+/// cap, Ė ≤ 0) or whose reduction has no two distinct re-solves: no Hessian without 2n extra
+/// re-solves, which SORM's budget does not take.
+pub const FORM_ONLY_NO_HESSIAN: &str = "no_hessian";
+/// A principal curvature with 1 + ψ(β)κ ≤ 0 (the formula does not hold).
+pub const FORM_ONLY_CURVATURE: &str = "curvature";
+/// The limit state failed at a point of SORM's differences.
+pub const FORM_ONLY_FAILED: &str = "failed";
+
+impl ComponentSorm {
+    /// FORM's P_f, for `why`.
+    pub fn form_only(r: &FormResult, why: &'static str) -> Self {
+        ComponentSorm {
+            pf: r.pf,
+            beta: r.beta,
+            form_only: Some(why),
+            seconds: 0.0,
+        }
+    }
+
+    /// From [`kappe_reliability::sorm`]'s answer at `r`'s design point.
+    pub fn of(s: Result<SormResult, kappe_reliability::Error>, r: &FormResult) -> Self {
+        match s {
+            Ok(s) => ComponentSorm {
+                pf: s.pf,
+                beta: if s.beta.is_finite() { s.beta } else { r.beta },
+                form_only: None,
+                seconds: 0.0,
+            },
+            Err(kappe_reliability::Error::SormCurvature { .. }) => {
+                Self::form_only(r, FORM_ONLY_CURVATURE)
+            }
+            Err(_) => Self::form_only(r, FORM_ONLY_FAILED),
+        }
+    }
+
+    /// [`Self::of`] with the seconds since `t0`.
+    fn timed(
+        s: Result<SormResult, kappe_reliability::Error>,
+        r: &FormResult,
+        t0: kappe_fe::clock::Instant,
+    ) -> Self {
+        ComponentSorm {
+            seconds: t0.elapsed().as_secs_f64(),
+            ..Self::of(s, r)
+        }
+    }
+
+    /// The component of the SORM series system: FORM's α with the equivalent β.
+    fn component(&self, r: &FormResult) -> Component {
+        Component {
+            beta: self.beta,
+            alpha: r.alpha.clone(),
+        }
+    }
+}
+
+/// The print's series system with every component's SORM P_f (module docs, "SORM").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct SormSystem {
+    /// β of the print: −Φ⁻¹(P_f). The `beta_min` verdict uses it.
+    pub beta: f64,
+    /// P_f of the print.
+    pub pf: f64,
+    /// 95 % interval of the series system's sampled P_f.
+    pub pf_interval: [f64; 2],
+    /// State of the governing component (largest SORM P_f).
+    pub governing_state: usize,
+    /// Check of the governing component.
+    pub governing_check: String,
+    /// Components that keep FORM's P_f, by reason (`first_order`: screened; `no_hessian`: a
+    /// time buckling component outside the 1-D reduction; `curvature`: 1 + ψκ ≤ 0; `failed`:
+    /// an evaluation failed). Absent when every component has its SORM P_f.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub form_only: BTreeMap<String, usize>,
+    /// Seconds SORM added, summed over the components (on whichever thread each ran) and the
+    /// print's second series system; the states' second systems (4 000 samples of a few
+    /// components each) are not counted.
+    pub seconds: f64,
 }
 
 /// One parameter's share in the governing check.
@@ -159,6 +282,22 @@ pub struct Reliability {
     /// without it): `crate::analysis::design_monte_carlo`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub monte_carlo: Option<super::design_monte_carlo::DesignMonteCarlo>,
+    /// The same series system with every component's SORM P_f (module docs, "SORM"); the
+    /// `beta_min` verdict uses its β ([`Reliability::verdict`]). FORM's numbers above stay.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sorm: Option<SormSystem>,
+}
+
+impl Reliability {
+    /// The β the `beta_min` verdict judges, with its governing state and check: SORM's (the
+    /// better estimate of the print's P_f: it takes the limit states' curvature at the design
+    /// points, which FORM leaves out) where there is one, else FORM's.
+    pub fn verdict(&self) -> (f64, usize, &str) {
+        match &self.sorm {
+            Some(s) => (s.beta, s.governing_state, &s.governing_check),
+            None => (self.beta, self.governing_state, &self.governing_check),
+        }
+    }
 }
 
 /// What a check of one state depends on; see the module docs.
@@ -645,8 +784,8 @@ struct ReducedBuckling {
 }
 
 impl ReducedBuckling {
-    /// L(y) and L′(y).
-    fn model(&self, y: f64) -> (f64, f64) {
+    /// L(y), L′(y) and L″(y) (the cubic's; 0 for the tangent line).
+    fn model(&self, y: f64) -> (f64, f64, f64) {
         match self.points.as_slice() {
             [.., [y1, f1, d1], [y2, f2, d2]] if (y2 - y1).abs() > 1e-12 => {
                 // Cubic Hermite on [y1, y2] in t = (y − y1)/h (also outside it).
@@ -663,10 +802,12 @@ impl ReducedBuckling {
                 let dh01 = -6.0 * t2 + 6.0 * t;
                 let dh11 = 3.0 * t2 - 2.0 * t;
                 let dv = (dh00 * f1 + dh01 * f2) / h + dh10 * d1 + dh11 * d2;
-                (v, dv)
+                let d2v = ((12.0 * t - 6.0) * (f1 - f2)) / (h * h)
+                    + ((6.0 * t - 4.0) * d1 + (6.0 * t - 2.0) * d2) / h;
+                (v, dv, d2v)
             }
-            [.., [y1, f1, d1]] => (f1 + d1 * (y - y1), *d1),
-            [] => (0.0, 0.0),
+            [.., [y1, f1, d1]] => (f1 + d1 * (y - y1), *d1, 0.0),
+            [] => (0.0, 0.0, 0.0),
         }
     }
 
@@ -676,7 +817,7 @@ impl ReducedBuckling {
             |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
         let e0 = at(v.e0t, self.e0);
         let rate = at(v.rate, self.rate0);
-        let (l, dl) = self.model((rate / e0).ln());
+        let (l, dl, _) = self.model((rate / e0).ln());
         let lambda = e0 * l.exp();
         let gamma = at(v.gamma, v.gamma0);
         let rg = gamma / v.gamma0;
@@ -696,6 +837,153 @@ impl ReducedBuckling {
         set(v.nu, self.k * lambda / rg * self.s_nu);
         val - self.blf_min
     }
+}
+
+impl ReducedBuckling {
+    /// G = ln(BLF/BLF_min) of the model, = ln k + ln E₀ + L(y) − ln(γ/γ₀) + ln(1 + s_ν(ν − ν₀))
+    /// − ln BLF_min, with its gradient and Hessian in x (row-major): SORM's limit state. Its
+    /// surface G = 0 is g's, and so are its curvatures (`kappe_reliability::sorm`, module
+    /// docs); in ln form the Hessian is sparse and closed:
+    /// ∂²G/∂E₀² = (L″ + L′ − 1)/E₀², ∂²G/∂E₀∂Ė = −L″/(E₀Ė), ∂²G/∂Ė² = (L″ − L′)/Ė²,
+    /// ∂²G/∂γ² = 1/γ², ∂²G/∂ν² = −(s_ν/(1 + s_ν(ν − ν₀)))².
+    fn ln_hessian(&self, x: &[f64], grad: &mut [f64], hess: &mut [f64]) -> f64 {
+        let v = self.vars;
+        let n = grad.len();
+        let at =
+            |i: Option<usize>, nominal: f64| i.and_then(|i| x.get(i).copied()).unwrap_or(nominal);
+        let e0 = at(v.e0t, self.e0);
+        let rate = at(v.rate, self.rate0);
+        let (l, dl, d2l) = self.model((rate / e0).ln());
+        let gamma = at(v.gamma, v.gamma0);
+        let nu = at(v.nu, v.nu0);
+        let lin = 1.0 + self.s_nu * (nu - v.nu0);
+        grad.iter_mut().for_each(|g| *g = 0.0);
+        hess.iter_mut().for_each(|h| *h = 0.0);
+        let mut set = |i: Option<usize>, d: f64| {
+            if let Some(g) = i.and_then(|i| grad.get_mut(i)) {
+                *g = d;
+            }
+        };
+        set(v.e0t, (1.0 - dl) / e0);
+        set(v.rate, dl / rate);
+        set(v.gamma, -1.0 / gamma);
+        set(v.nu, self.s_nu / lin);
+        let mut put = |i: Option<usize>, j: Option<usize>, d: f64| {
+            if let (Some(i), Some(j)) = (i, j)
+                && let Some(h) = hess.get_mut(i * n + j)
+            {
+                *h = d;
+            }
+        };
+        put(v.e0t, v.e0t, (d2l + dl - 1.0) / (e0 * e0));
+        put(v.e0t, v.rate, -d2l / (e0 * rate));
+        put(v.rate, v.e0t, -d2l / (e0 * rate));
+        put(v.rate, v.rate, (d2l - dl) / (rate * rate));
+        put(v.gamma, v.gamma, 1.0 / (gamma * gamma));
+        put(v.nu, v.nu, -(self.s_nu / lin).powi(2));
+        self.k.ln() + e0.ln() + l - (gamma / v.gamma0).ln() + lin.ln() - self.blf_min.ln()
+    }
+}
+
+/// Largest distance h in y = ln(Ė/E₀) between the design point's re-solve and the one before
+/// it for the Hermite cubic's L″ at the design point (truncation ≈ h²L⁗/12: ≈ 3·10⁻⁵·L⁗ at
+/// h = 0.02); the smallest is a tenth of it (the noise of the re-solves' L′, ≈ 10⁻⁸ by the
+/// Lanczos residual, enters L″ as 2·10⁻⁸/h: ≤ 10⁻⁵ there). Outside that band one more
+/// re-solve at y* + SORM_Y_STEP takes the other end. Measured on study No. 14's cap
+/// (every-8th-row shell): with the last two re-solves as FORM left them (often within 10⁻⁶ of
+/// each other in y, near convergence) L″ moved β by up to 0.06 and rejected one state's
+/// curvature (docs/reliability.md, "SORM").
+pub const SORM_Y_STEP: f64 = 0.02;
+
+/// SORM of a [`TimeBuckling`] component at its FORM result `r` (module docs, "SORM"), through
+/// the 1-D reduction: L = ln Λ is the Hermite cubic through the design point's re-solve and a
+/// re-solve 0.1–1 × [`SORM_Y_STEP`] from it in y (the one before it when there, else one more
+/// re-solve at y* + SORM_Y_STEP), so L and L′ there are the re-solve's own and L″ is the
+/// cubic's, and the Hessian of G = ln(BLF/BLF_min) is closed-form
+/// ([`ReducedBuckling::ln_hessian`]). FORM's P_f, flagged [`FORM_ONLY_NO_HESSIAN`], where the
+/// reduction does not hold, the last re-solve is not at the design point, or the extra
+/// re-solve fails.
+pub fn time_buckling_sorm(
+    model: &Model,
+    g: &mut TimeBuckling<'_>,
+    r: &FormResult,
+) -> ComponentSorm {
+    let t0 = kappe_fe::clock::Instant::now();
+    let no_hessian = || ComponentSorm::form_only(r, FORM_ONLY_NO_HESSIAN);
+    let Some(shell0) = g.shell0 else {
+        return no_hessian();
+    };
+    if !g.reducible() {
+        return no_hessian();
+    }
+    let v = g.vars;
+    let (e00, rate0) = (g.time.youngs_modulus.initial, g.time.youngs_modulus.rate);
+    let at = |i: Option<usize>, nominal: f64| {
+        i.and_then(|i| r.x_star.get(i).copied()).unwrap_or(nominal)
+    };
+    let (e_star, rate_star) = (at(v.e0t, e00), at(v.rate, rate0));
+    let y = |s: &[f64; 4]| (s[1] / s[0]).ln();
+    let far = match g.solves.as_slice() {
+        [.., a, b] => !(0.1 * SORM_Y_STEP..=SORM_Y_STEP).contains(&(y(b) - y(a)).abs()),
+        _ => true,
+    };
+    if far {
+        // One more re-solve at y* + SORM_Y_STEP: Ė × e^h where Ė is random, else E₀ × e^−h.
+        use kappe_reliability::LimitState;
+        let mut x = r.x_star.clone();
+        let moved = match (v.rate, v.e0t) {
+            (Some(i), _) => x.get_mut(i).map(|e| *e *= SORM_Y_STEP.exp()),
+            (None, Some(i)) => x.get_mut(i).map(|e| *e *= (-SORM_Y_STEP).exp()),
+            (None, None) => None,
+        };
+        if moved.is_none() || g.value(&x).is_err() {
+            return no_hessian();
+        }
+        // The cubic runs from the extra point to the design point's (`b` last).
+        if let Some(star) = g
+            .solves
+            .iter()
+            .rev()
+            .find(|s| s[0] == e_star && s[1] == rate_star)
+            .copied()
+        {
+            g.solves.push(star);
+        }
+    }
+    let last: Vec<&[f64; 4]> = g.solves.iter().rev().take(2).rev().collect();
+    let &[a, b] = last.as_slice() else {
+        return no_hessian();
+    };
+    let same = |p: f64, q: f64| (p - q).abs() <= 1e-12 * q.abs();
+    if !(same(b[0], e_star) && same(b[1], rate_star))
+        || [a, b]
+            .iter()
+            .any(|s| !(s[0] > 0.0 && s[1] > 0.0 && s[2] > 0.0))
+    {
+        return no_hessian();
+    }
+    let point = |[e0, rate, l, dl]: [f64; 4]| [(rate / e0).ln(), (l / e0).ln(), rate * dl / l];
+    let points = vec![point(*a), point(*b)];
+    if (points[1][0] - points[0][0]).abs() <= 1e-12 {
+        return no_hessian();
+    }
+    let reduced = ReducedBuckling {
+        vars: v,
+        e0: e00,
+        rate0,
+        k: g.check.0 / shell0,
+        s_nu: g.check.1,
+        blf_min: g.blf_min,
+        points,
+    };
+    let mut ls = kappe_reliability::WithHessian(|x: &[f64], grad: &mut [f64], hess: &mut [f64]| {
+        reduced.ln_hessian(x, grad, hess)
+    });
+    ComponentSorm::timed(
+        kappe_reliability::sorm(model, &mut ls, r, &SormOptions::default()),
+        r,
+        t0,
+    )
 }
 
 /// FORM of a [`TimeBuckling`] component, through its 1-D reduction where λ = E₀·Λ(Ė/E₀)
@@ -1157,8 +1445,12 @@ impl GreenField {
 /// A design's uncertain model, its drifts and where the variables sit.
 pub type Prepared = (Model, Vec<(String, Drift)>, Vars);
 
-/// FORM results of one state: its reliability and each check's FORM result by check name.
-pub type StateForm = (StateReliability, Vec<(&'static str, FormResult)>);
+/// FORM results of one state: its reliability and each component's check name, FORM result
+/// and SORM.
+pub type StateForm = (
+    StateReliability,
+    Vec<(&'static str, FormResult, ComponentSorm)>,
+);
 
 /// The uncertain model of a design, its drifts and where the variables sit: what every state's
 /// FORM needs. None without `[uncertainty]`.
@@ -1270,7 +1562,8 @@ fn state_form_with<'a>(
         // (`time_buckling_form`), from the solve at the means when `first_order` made it.
         let time_buckling = match (check, prebuilt.take(), &time) {
             (Check::BucklingTime { .. }, Some(Prebuilt::Screened(r)), _) => {
-                given.push((check.name(), *r));
+                let s = ComponentSorm::form_only(&r, FORM_ONLY_FIRST_ORDER);
+                given.push((check.name(), *r, s));
                 first_order = true;
                 continue;
             }
@@ -1296,7 +1589,8 @@ fn state_form_with<'a>(
         };
         if let Some(mut g) = time_buckling {
             if let Some(r) = time_form(&state_model, g.as_mut()).map_err(rel_err)? {
-                given.push((check.name(), r));
+                let s = time_buckling_sorm(&state_model, &mut g, &r);
+                given.push((check.name(), r, s));
             }
             continue;
         }
@@ -1598,10 +1892,12 @@ pub fn form_checks<'a>(
 
 /// [`form_checks`] with `given` components (solved already, or screened: first-order results)
 /// joining the state's system; the state is flagged `beta_first_order` when `first_order`.
+/// Each component's SORM at its design point (module docs, "SORM"): the named limit states'
+/// by [`kappe_reliability::sorm`] (their Hessian by differences), the given ones' as given.
 fn form_checks_with<'a>(
     model: &Model,
     checks: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)>,
-    given: Vec<(&'static str, FormResult)>,
+    given: Vec<(&'static str, FormResult, ComponentSorm)>,
     first_order: bool,
     index: usize,
     t_hours: f64,
@@ -1609,14 +1905,16 @@ fn form_checks_with<'a>(
 ) -> Result<StateForm, kappe_reliability::Error> {
     let mut by_check = BTreeMap::new();
     let mut own = Vec::new();
+    let mut own_sorm = Vec::new();
     let mut results = Vec::new();
-    for (name, r) in given {
+    for (name, r, s) in given {
         by_check
             .entry(name.to_owned())
             .and_modify(|b: &mut f64| *b = b.min(r.beta))
             .or_insert(r.beta);
         own.push(Component::from(&r));
-        results.push((name, r));
+        own_sorm.push(s.component(&r));
+        results.push((name, r, s));
     }
     for (name, mut g) in checks {
         let r = match form(model, g.as_mut(), &FormOptions::default()) {
@@ -1629,6 +1927,12 @@ fn form_checks_with<'a>(
             }
             Err(e) => return Err(e),
         };
+        let t0 = kappe_fe::clock::Instant::now();
+        let s = ComponentSorm::timed(
+            kappe_reliability::sorm(model, g.as_mut(), &r, &SormOptions::default()),
+            &r,
+            t0,
+        );
         // Several components of one check (e.g. a buildability object's layers): the
         // weakest one's β.
         by_check
@@ -1636,16 +1940,17 @@ fn form_checks_with<'a>(
             .and_modify(|b: &mut f64| *b = b.min(r.beta))
             .or_insert(r.beta);
         own.push(Component::from(&r));
-        results.push((name, r));
+        own_sorm.push(s.component(&r));
+        results.push((name, r, s));
     }
-    let sys = series_system(
-        &own,
-        &SystemOptions {
-            samples: STATE_SYSTEM_SAMPLES,
-            seed,
-            ditlevsen: false,
-        },
-    )?;
+    let options = SystemOptions {
+        samples: STATE_SYSTEM_SAMPLES,
+        seed,
+        ditlevsen: false,
+    };
+    let sys = series_system(&own, &options)?;
+    // The same sampler and seed: where every component keeps FORM's β the two agree to the bit.
+    let sorm = series_system(&own_sorm, &options)?;
     Ok((
         StateReliability {
             index,
@@ -1654,6 +1959,8 @@ fn form_checks_with<'a>(
             pf: sys.pf,
             beta_by_check: by_check,
             beta_first_order: first_order,
+            beta_sorm: Some(sorm.beta),
+            pf_sorm: Some(sorm.pf),
         },
         results,
     ))
@@ -1696,7 +2003,7 @@ pub fn reliability(
     let v = Vars::of(&model, cap);
     let k = &cap.design.constraints;
     let per_state = state_checks(cap, analysis, schedule, v)?;
-    let mut results: Vec<(usize, &'static str, FormResult)> = Vec::new();
+    let mut results: Vec<PrintComponent> = Vec::new();
     let mut states = Vec::new();
     let prepared = (&model, drifts.as_slice(), v);
     let options = &analysis.options;
@@ -1732,7 +2039,7 @@ pub fn reliability(
         )?;
         let bound = done
             .iter()
-            .flat_map(|(_, rs)| rs.iter().map(|(_, r)| r.pf))
+            .flat_map(|(_, rs)| rs.iter().map(|(_, r, _)| r.pf))
             .fold(0.0_f64, f64::max);
         let n = order.len() as f64;
         for &(i, beta1) in order.iter().skip(1) {
@@ -1773,8 +2080,8 @@ pub fn reliability(
     let per_state = solved.into_iter().zip(rest).map(|(a, b)| a.or(b));
     for (state, rs) in per_state.flatten() {
         let index = state.index;
-        for (name, r) in rs {
-            results.push((index, name, r));
+        for (name, r, s) in rs {
+            results.push((index, name, r, s));
         }
         states.push(state);
     }
@@ -1800,24 +2107,51 @@ pub fn reliability(
     .map(Some)
 }
 
-/// The print's reliability from every state's FORM results (state index, check name, result):
-/// the series system over all of them, its governing component's design point and
-/// sensitivities. The one implementation behind the cap's and the buildability objects' blocks.
+/// One component of the print: state index, check name, FORM result and SORM.
+pub type PrintComponent = (usize, &'static str, FormResult, ComponentSorm);
+
+/// The print's reliability from every state's FORM results (state index, check name, result,
+/// SORM): the series system over all of them, its governing component's design point and
+/// sensitivities, and the same system with the components' SORM P_f ([`SormSystem`], the same
+/// sampler and seed). The one implementation behind the cap's and the buildability objects'
+/// blocks.
 ///
 /// # Errors
 /// No component, or a failed series-system estimate.
 pub fn print_reliability(
-    results: Vec<(usize, &'static str, FormResult)>,
+    results: Vec<PrintComponent>,
     states: Vec<StateReliability>,
     system: &SystemOptions,
     beta_min: f64,
     t0: kappe_fe::clock::Instant,
 ) -> Result<Reliability, DesignError> {
-    let components: Vec<Component> = results.iter().map(|(_, _, r)| Component::from(r)).collect();
+    let components: Vec<Component> = results
+        .iter()
+        .map(|(_, _, r, _)| Component::from(r))
+        .collect();
     let sys = series_system(&components, system).map_err(rel_err)?;
-    let Some((gov_state, gov_check, gov)) = results.get(sys.governing) else {
+    let Some((gov_state, gov_check, gov, _)) = results.get(sys.governing) else {
         return Err(rel_err(kappe_reliability::Error::NoComponents));
     };
+    let t_sorm = kappe_fe::clock::Instant::now();
+    let with_sorm: Vec<Component> = results.iter().map(|(_, _, r, s)| s.component(r)).collect();
+    let sorm_sys = series_system(&with_sorm, system).map_err(rel_err)?;
+    let mut form_only = BTreeMap::new();
+    for why in results.iter().filter_map(|(_, _, _, s)| s.form_only) {
+        *form_only.entry(why.to_owned()).or_insert(0) += 1;
+    }
+    let sorm = results
+        .get(sorm_sys.governing)
+        .map(|(state, check, _, _)| SormSystem {
+            beta: sorm_sys.beta,
+            pf: sorm_sys.pf,
+            pf_interval: sorm_sys.interval,
+            governing_state: *state,
+            governing_check: (*check).to_owned(),
+            form_only,
+            seconds: t_sorm.elapsed().as_secs_f64()
+                + results.iter().map(|(_, _, _, s)| s.seconds).sum::<f64>(),
+        });
     let names = &gov.names;
     let design_point = names.iter().cloned().zip(gov.x_star.clone()).collect();
     let sensitivities = names
@@ -1848,5 +2182,6 @@ pub fn print_reliability(
         components: components.len(),
         seconds: t0.elapsed().as_secs_f64(),
         monte_carlo: None,
+        sorm,
     })
 }

@@ -503,6 +503,13 @@ pub struct BuildState {
     /// β per check (`buckling`, `strength`, `sliding`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub beta_by_check: Option<std::collections::BTreeMap<String, f64>>,
+    /// β of the state's series system with each component's SORM P_f (docs/reliability.md,
+    /// "SORM"; with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_sorm: Option<f64>,
+    /// P_f of that system.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pf_sorm: Option<f64>,
 }
 
 /// The result (`buildability.json`).
@@ -697,6 +704,8 @@ pub fn check_layers_cached(
             beta: None,
             pf: None,
             beta_by_check: None,
+            beta_sorm: None,
+            pf_sorm: None,
         },
         mode,
     ))
@@ -770,6 +779,8 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
                     s.beta = Some(x.beta);
                     s.pf = Some(x.pf);
                     s.beta_by_check = Some(x.beta_by_check.clone());
+                    s.beta_sorm = x.beta_sorm;
+                    s.pf_sorm = x.pf_sorm;
                 }
             }
             (Some(rel), mc, col)

@@ -39,13 +39,13 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use kappe_reliability::{
-    Batch, EvalError, Fallible, FormResult, Model, SamplingOptions, SamplingResult, SystemOptions,
+    Batch, EvalError, Fallible, Model, SamplingOptions, SamplingResult, SystemOptions,
     merge_events, sample_events,
 };
 
 use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
 use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
-use crate::analysis::reliability::{Reliability, StateReliability, form_checks, print_reliability};
+use crate::analysis::reliability::{Reliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
 use crate::commands::buildability_collapse::{
     CollapseTables, IMPERFECTION, check_collapse_axes, imperfection_nominal,
@@ -1152,7 +1152,7 @@ fn first_order_at_the_means(
 }
 
 /// FORM of every check of the layer counts `states` (n, its deterministic values) and the
-/// print's series system; per state its [`StateReliability`] (index = n) and its check results.
+/// print's series system; per state its [`crate::analysis::reliability::StateReliability`] (index = n) and its check results.
 ///
 /// # Errors
 /// A drift factor that is not positive, a failed re-solve, FORM that does not converge, or no
@@ -1182,7 +1182,7 @@ pub fn reliability_with_points(
     let p = &sur.prepared;
     let blf_min = r.spec.checks.blf_min;
     let seed = table.seed.unwrap_or(0);
-    type StateOut = Option<(StateReliability, Vec<(&'static str, FormResult)>)>;
+    type StateOut = Option<crate::analysis::reliability::StateForm>;
     let per_state: Vec<StateOut> = states
         .par_iter()
         .map(|&(n, v)| -> Result<StateOut, DesignError> {
@@ -1278,11 +1278,11 @@ pub fn reliability_with_points(
     let mut out = Vec::new();
     let mut points = Vec::new();
     for (s, rs) in per_state.into_iter().flatten() {
-        for (name, f) in rs {
+        for (name, f, so) in rs {
             if name == "collapse" {
                 points.push((s.index, f.clone()));
             }
-            results.push((s.index, name, f));
+            results.push((s.index, name, f, so));
         }
         out.push(s);
     }

@@ -16,8 +16,9 @@
 //! age in the time models of [`crate::input::material`] (non-negative rates), which the bisection needs.
 //!
 //! **β target (issue 24).** With `[uncertainty]` a state passes only when, besides the
-//! deterministic checks, its reliability index β (FORM of its random checks as a series system,
-//! [`crate::analysis::reliability::state_form`], the function the run's reliability uses) reaches
+//! deterministic checks, its reliability index β (SORM of its random checks as a series system,
+//! FORM where SORM does not apply; [`crate::analysis::reliability::state_form`], the function
+//! the run's reliability uses, and the β its `beta_min` verdict judges) reaches
 //! `constraints.beta_min` (default [`crate::input::uncertainty::BETA_MIN_DEFAULT`]). The state's
 //! variables are drifted to its print time on the schedule being tried, so a drying mix is
 //! followed exactly: a wait ages the layers below (stiffer) but prints the top later (drifted).
@@ -151,7 +152,8 @@ pub fn check_state_on(
                 t_hours,
                 &checks,
             )?
-            .map(|(r, _)| r.beta)
+            // The state's SORM β where it has one, as the run's `beta_min` verdict judges.
+            .map(|(r, _)| r.beta_sorm.unwrap_or(r.beta))
         }
         None => None,
     };

@@ -305,11 +305,15 @@ impl Outcome {
             format!("{:.1}", self.print_time() / 60.0),
         );
         if let Some(r) = &self.reliability {
-            // One line (issue 24): the print's β against its target, and P_f.
+            // One line (issue 24): the print's β against its target, and P_f (FORM's, then
+            // SORM's, which the verdict judges).
             row(
                 &mut t,
                 &format!("reliability β (min {:.2}) / P_f", r.beta_min),
-                format!("{:.2} / {:.2e}", r.beta, r.pf),
+                format!("{:.2} / {:.2e}", r.beta, r.pf)
+                    + &r.sorm.as_ref().map_or(String::new(), |s| {
+                        format!(", SORM {:.2} / {:.2e}", s.beta, s.pf)
+                    }),
             );
             if let Some(mc) = &r.monte_carlo {
                 // FORM's P_f against the sampled one, with its 95 % interval.
@@ -334,7 +338,16 @@ impl Outcome {
                         } else {
                             "outside"
                         }
-                    ),
+                    ) + &mc.sorm_pf.map_or(String::new(), |p| {
+                        format!(
+                            ", SORM {p:.3e} {}",
+                            if mc.sorm_in_interval == Some(true) {
+                                "inside"
+                            } else {
+                                "outside"
+                            }
+                        )
+                    }),
                 );
             }
         }

@@ -255,6 +255,13 @@ pub struct StateEntry {
     /// "Screening"; only with `[uncertainty]`, absent when false).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub beta_first_order: bool,
+    /// β of the state's series system with each component's SORM P_f (docs/reliability.md,
+    /// "SORM"; only with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta_sorm: Option<f64>,
+    /// P_f of that system (only with `[uncertainty]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pf_sorm: Option<f64>,
 }
 
 /// The as-printed shape over the whole print (per state: `states[].crown_sag_m`,
@@ -547,6 +554,8 @@ impl Outcome {
                     pf: r.map(|r| r.pf),
                     beta_by_check: r.map(|r| r.beta_by_check.clone()),
                     beta_first_order: r.is_some_and(|r| r.beta_first_order),
+                    beta_sorm: r.and_then(|r| r.beta_sorm),
+                    pf_sorm: r.and_then(|r| r.pf_sorm),
                 }
             })
             .collect();

@@ -120,6 +120,32 @@ fn form_of_the_strength_state_agrees_with_monte_carlo() {
     assert!(mc.pf >= m[0]);
 }
 
+/// The same state with the scatter of ḟ (cov 0.1), where FORM's P_f (0.0263) lay outside the
+/// sampled interval (docs/reliability.md, Limits): the state's SORM P_f (its components'
+/// Hohenbichler–Rackwitz P_f, the Hessian of the table-based g by second differences, in the
+/// state's series system) against the same 10⁴ crude samples (seed 5), inside the 95 % (Wilson)
+/// interval.
+#[test]
+fn sorm_of_the_strength_state_with_the_rate_agrees_with_monte_carlo() {
+    let (r, table) = resolved(&scatter());
+    let sur = Surrogate::build(&r, prepare(&r, &table).unwrap()).unwrap();
+    let values: Vec<_> = (1..=12)
+        .map(|n| (n, sur.state(&r, n, &sur.prepared.nominal).unwrap()))
+        .collect();
+    let rel = reliability(&r, &sur, &values, &table).unwrap();
+    let s12 = rel.states.iter().find(|s| s.index == 12).unwrap();
+    let mc = monte_carlo(&r, &sur, 10_000, 5).unwrap();
+    let m = mc.state_pf[11];
+    let sorm = s12.pf_sorm.unwrap();
+    eprintln!("12 layers: FORM {}, SORM {sorm}, Monte Carlo {m:?}", s12.pf);
+    assert!(m[0] > 0.01 && m[0] < 0.5, "an informative P_f: {m:?}");
+    assert!(
+        sorm >= m[1] && sorm <= m[2],
+        "SORM {sorm} (FORM {}) vs MC {m:?}",
+        s12.pf
+    );
+}
+
 #[test]
 fn monte_carlo_batches_merge_into_the_single_run_bit_for_bit() {
     let (r, table) = resolved(&scatter());

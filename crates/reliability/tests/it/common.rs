@@ -21,23 +21,3 @@ pub fn ln_params(mean: f64, cov: f64) -> (f64, f64) {
     let zeta2 = (1.0 + cov * cov).ln();
     (mean.ln() - 0.5 * zeta2, zeta2.sqrt())
 }
-
-/// Breitung's (1984) second-order factor 1/√(1 + βκ) of a 2-variable FORM result: κ = t̂ᵀHt̂/‖∇G‖
-/// is the curvature of G(u) = 0 at u* (t̂ ⊥ α; κ > 0 when the surface bends away from the origin),
-/// from central differences of G in u with step 10⁻³ (error ~10⁻⁶ in κ).
-pub fn breitung_factor(
-    model: &kappe_reliability::Model,
-    g: impl Fn(&[f64]) -> f64,
-    f: &kappe_reliability::FormResult,
-) -> f64 {
-    let h = 1e-3;
-    let at = |dir: [f64; 2], s: f64| {
-        let u = [f.u_star[0] + s * dir[0], f.u_star[1] + s * dir[1]];
-        g(&model.x_from_u(&u))
-    };
-    let t = [f.alpha[1], -f.alpha[0]];
-    let a = [f.alpha[0], f.alpha[1]];
-    let second = (at(t, h) - 2.0 * at(t, 0.0) + at(t, -h)) / (h * h);
-    let slope = -(at(a, h) - at(a, -h)) / (2.0 * h);
-    1.0 / (1.0 + f.beta * second / slope).sqrt()
-}

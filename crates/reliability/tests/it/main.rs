@@ -7,5 +7,6 @@ mod form_closed_forms;
 mod form_literature;
 mod nataf;
 mod sampling;
+mod sorm;
 mod spec;
 mod system;
