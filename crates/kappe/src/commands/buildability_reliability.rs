@@ -39,7 +39,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use kappe_reliability::{
-    Batch, EvalError, Fallible, Model, SamplingOptions, SamplingResult, SystemOptions,
+    Batch, EvalError, Fallible, FormResult, Model, SamplingOptions, SamplingResult, SystemOptions,
     merge_events, sample_events,
 };
 
