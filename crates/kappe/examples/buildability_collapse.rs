@@ -93,8 +93,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         col.mixed_modes
     );
     println!(
-        "\n{:>3} {:>9} {:>12} {:>8} {:>10} {:>10} {:>10}",
-        "n", "λ_c", "mode", "β_coll", "P_f FORM", "P_f MC", "failed by"
+        "\n{:>3} {:>9} {:>12} {:>8} {:>10} {:>10} {:>10} {:>10}",
+        "n", "λ_c", "mode", "β_coll", "P_f FORM", "state SORM", "P_f MC", "failed by"
     );
     for s in &b.states {
         let beta = s
@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .copied();
         let n = s.layers;
         println!(
-            "{n:>3} {:>9.4} {:>12} {:>8} {:>10} {:>10.4} {:>10.4}",
+            "{n:>3} {:>9.4} {:>12} {:>8} {:>10} {:>10} {:>10.4} {:>10.4}",
             s.collapse_factor.unwrap_or(f64::NAN),
             s.collapse_mode.map_or("-", |m| m.name()),
             beta.map_or("-".into(), |b| format!("{b:.3}")),
@@ -112,6 +112,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "{:.4}",
                 kappe_reliability::stdnormal::cdf(-b)
             )),
+            s.pf_sorm.map_or("-".into(), |p| format!("{p:.4}")),
             mc.state_pf.get(n - 1).map_or(f64::NAN, |v| v[0]),
             mc.failed_by.get(n - 1).copied().unwrap_or(f64::NAN),
         );
@@ -128,6 +129,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mc.pf_interval[1],
         mc.resolves
     );
+    if let Some(so) = &rel.sorm {
+        println!(
+            "print: SORM β {:.3}, P_f {:.4e} (governing layer {} {}); components left at FORM: \
+             {:?}",
+            so.beta, so.pf, so.governing_state, so.governing_check, so.form_only
+        );
+    }
     println!(
         "failure layer: mean {:.2}, sd {:.2} (Monte Carlo, the failing samples); printed \
          cylinders 25, 27, 30, 31, 31: mean 28.8, sd 2.7",
