@@ -99,10 +99,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         t2.elapsed().as_secs_f64()
     );
     println!(
-        "  {:>3} {:>8} {:>10} {:>10} {:>21}  within",
-        "n", "beta", "FORM pf", "MC pf", "MC 95 % interval"
+        "  {:>3} {:>8} {:>10} {:>10} {:>10} {:>21}  FORM / SORM within",
+        "n", "beta", "FORM pf", "SORM pf", "MC pf", "MC 95 % interval"
     );
     let mut inside = 0;
+    let mut inside_sorm = 0;
     let mut compared = 0;
     for s in &rel.states {
         let Some(m) = mc.state_pf.get(s.index - 1) else {
@@ -112,24 +113,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // does not see it always.
         let informative = m[0] * samples as f64 >= 10.0 && m[0] < 0.999;
         let ok = s.pf >= m[1] && s.pf <= m[2];
+        let ok_sorm = s.pf_sorm.is_some_and(|p| p >= m[1] && p <= m[2]);
         if informative {
             compared += 1;
             inside += usize::from(ok);
+            inside_sorm += usize::from(ok_sorm);
         }
         if informative || s.index % 10 == 0 {
             println!(
-                "  {:>3} {:>8.3} {:>10.4} {:>10.4} [{:>8.4}, {:>8.4}]  {}",
+                "  {:>3} {:>8.3} {:>10.4} {:>10} {:>10.4} [{:>8.4}, {:>8.4}]  {} / {}",
                 s.index,
                 s.beta,
                 s.pf,
+                s.pf_sorm.map_or("-".into(), |p| format!("{p:.4}")),
                 m[0],
                 m[1],
                 m[2],
-                if ok { "yes" } else { "no" }
+                if ok { "yes" } else { "no" },
+                if ok_sorm { "yes" } else { "no" }
             );
         }
     }
-    println!("  FORM inside the 95 % interval at {inside} of {compared} informative layer counts");
+    println!(
+        "  FORM inside the 95 % interval at {inside} of {compared} informative layer counts, \
+         SORM at {inside_sorm}"
+    );
 
     let opts = SamplingOptions::new(samples.min(3000), 7);
     let one = monte_carlo_batch(&r, &sur, &opts, Batch { index: 0, count: 1 })?;
