@@ -267,6 +267,16 @@ impl UncertaintyTable {
                         .to_owned(),
                 );
             }
+            if name == "analysis.nonlinear.imperfection" {
+                // Accepted by buildability specs (commands::buildability_collapse); a design's
+                // collapse is not yet a limit state of its reliability (docs/reliability.md).
+                return Err(
+                    "the imperfection amplitude is an uncertain input of buildability specs \
+                     with [analysis.nonlinear] (kappe buildability); a design's collapse is \
+                     not yet a limit state of its reliability"
+                        .to_owned(),
+                );
+            }
             if STRENGTH_PARAMETERS.contains(&name) {
                 let time = design.time_model().map_err(|e| e.to_string())?;
                 return strength_nominal(&time, name).map(|v| (v, true));

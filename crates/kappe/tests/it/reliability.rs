@@ -50,6 +50,13 @@ fn bad_uncertainty_is_a_named_error() {
              \"material.specific_weight\" = { \"material.poisson_ratio\" = -0.9 }\n",
             "uncertainty.correlation",
         ),
+        (
+            // A design's collapse is not a limit state yet: the name is refused with the
+            // reason and where it is accepted, not as an unknown name.
+            "[analysis.nonlinear]\nimperfection = 0.002\n[uncertainty]\n\
+             \"analysis.nonlinear.imperfection\" = { dist = \"lognormal\", cov = 0.5 }\n",
+            "kappe buildability",
+        ),
     ];
     for (text, needle) in cases {
         let e = with_uncertainty(text).unwrap_err();
