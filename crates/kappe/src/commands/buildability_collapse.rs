@@ -98,13 +98,12 @@ use crate::analysis::collapse::{Collapse, CollapseMode};
 use crate::analysis::design_monte_carlo::{bary_into, cheb};
 use crate::commands::buildability::{BuildState, Resolved, check_layers};
 use crate::commands::buildability_reliability::{
-    E0, F0, FRATE, GAMMA, PARAMETERS, Prepared, RATE, T, Z_RANGE, bary_continued, resolved_at,
-    t_hours, uerr, variable_box,
+    E0, F0, FRATE, GAMMA, PARAMETERS, Prepared, RATE, T, Z_RANGE, resolved_at, t_hours,
+    table_coefficients, uerr, variable_box,
 };
 use crate::input::error::DesignError;
 
-/// The name of the imperfection amplitude in a buildability spec's `[uncertainty]`.
-pub const IMPERFECTION: &str = "analysis.nonlinear.imperfection";
+pub use crate::input::uncertainty::IMPERFECTION;
 
 /// Chebyshev points per axis of a collapse table. λ_c is smooth in each parameter away from a
 /// kink (see the module docs); 5 points per axis (25 paths per state with two axes) keep a
@@ -560,16 +559,7 @@ impl CollapseTables {
         for a in &self.axes {
             let s = x.get(a.var).copied().unwrap_or(f64::NAN).ln();
             let mut c = vec![0.0; a.nodes.len()];
-            let [lo, hi] = a.range;
-            if s >= lo && s <= hi {
-                bary_into(&a.nodes, &a.weights, s, &mut c);
-            } else if clamp && !s.is_nan() {
-                // A FORM iterate far out (x → 0 or ∞ underflows the logarithm): held at 10³
-                // box widths beyond the edge, where the continued line stays finite.
-                let far = 1e3 * (hi - lo);
-                let s = s.clamp(lo - far, hi + far);
-                bary_continued(&a.nodes, &a.weights, a.range, s, &mut c);
-            } else {
+            if !table_coefficients(&a.nodes, &a.weights, a.range, s, clamp, &mut c) {
                 fallbacks.fetch_add(1, Ordering::Relaxed);
                 return Self::direct_at(r, p, n, x).map(|c| Some(c.factor));
             }

@@ -477,6 +477,32 @@ pub(crate) fn bary_continued(
     }
 }
 
+/// The barycentric coefficients of a table axis over `[lo, hi]` at s, into `out`: inside the
+/// range the interpolant's; outside it, with `clamp` (FORM), the straight continuation of
+/// [`bary_continued`], s held at 10³ box widths beyond the edge (FORM's far iterates, where
+/// x → 0 or ∞ underflows the logarithm, stay finite so FORM reports a far β instead of failing
+/// on an evaluation). `false` when s is outside without `clamp` (or NaN): the caller falls back
+/// to a direct solve and counts it.
+pub(crate) fn table_coefficients(
+    nodes: &[f64],
+    weights: &[f64],
+    [lo, hi]: [f64; 2],
+    s: f64,
+    clamp: bool,
+    out: &mut [f64],
+) -> bool {
+    if (lo..=hi).contains(&s) {
+        bary_into(nodes, weights, s, out);
+        true
+    } else if clamp && !s.is_nan() {
+        let far = 1e3 * (hi - lo);
+        bary_continued(nodes, weights, [lo, hi], s.clamp(lo - far, hi + far), out);
+        true
+    } else {
+        false
+    }
+}
+
 /// Per model variable, the range [lo, hi] of ±[`Z_RANGE`] standard deviations over every
 /// state's drifted model (layer counts 1..=`max_layers`): the box the tables cover.
 ///
@@ -724,26 +750,10 @@ impl Surrogate {
             let tf = if self.t_scales { p[T] / nom[T] } else { 1.0 };
             let rho = p[RATE] / p[E0] * tf;
             let s = rho.ln();
-            let [lo, hi] = self.range;
-            if clamp && !s.is_nan() && !(lo..=hi).contains(&s) {
-                // A FORM iterate far out (E₀ → 0 underflows: a check that depends on E₀ only
-                // through ρ, e.g. strength with E₀ alone uncertain, has a flat surface there)
-                // is held at 10³ box widths beyond the edge: finite, so FORM reports its far
-                // β instead of failing on an evaluation.
-                let far = 1e3 * (hi - lo);
-                bary_continued(
-                    &self.nodes,
-                    &self.weights,
-                    self.range,
-                    s.clamp(lo - far, hi + far),
-                    coef,
-                );
-            } else if !(s >= lo && s <= hi) {
+            if !table_coefficients(&self.nodes, &self.weights, self.range, s, clamp, coef) {
                 self.fallbacks
                     .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 return exact_state(r, n, p);
-            } else {
-                bary_into(&self.nodes, &self.weights, s, coef);
             }
         }
         let at = |v: &[f64], stride: usize, i: usize| -> f64 {

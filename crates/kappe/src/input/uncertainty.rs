@@ -21,6 +21,10 @@
 
 use std::collections::BTreeMap;
 
+/// The name of the imperfection amplitude in `[uncertainty]`: an input of buildability specs
+/// with `[analysis.nonlinear]` (`commands::buildability_collapse`), refused in a design.
+pub const IMPERFECTION: &str = "analysis.nonlinear.imperfection";
+
 use kappe_reliability::{Correlation, Drift, Model, UncertaintySpec};
 use serde::{Deserialize, Serialize};
 
@@ -267,7 +271,7 @@ impl UncertaintyTable {
                         .to_owned(),
                 );
             }
-            if name == "analysis.nonlinear.imperfection" {
+            if name == IMPERFECTION {
                 // Accepted by buildability specs (commands::buildability_collapse); a design's
                 // collapse is not yet a limit state of its reliability (docs/reliability.md).
                 return Err(
