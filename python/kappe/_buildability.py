@@ -4,8 +4,9 @@ locally, or one Dask task per batch when given a ``dask.distributed.Client``. Th
 the library's (``kappe buildability`` runs the same functions in one batch), so the merged result
 equals the local run with the same seed, bit for bit, whatever the number of batches. On Dask the
 spec's interpolation tables (the costly part) are built once, in parts over the workers (two per
-worker, consecutive layer counts of about equal work), joined, and shipped to every batch: no
-worker builds them again, and the shipped tables carry every number's bits."""
+worker, consecutive layer counts of about equal work), with the collapse tables of a spec with
+``[analysis.nonlinear]`` as one more task, joined, and shipped to every batch: no worker builds
+them again, and the shipped tables carry every number's bits."""
 
 from __future__ import annotations
 
@@ -24,9 +25,18 @@ def _table_part(text: str, index: int, count: int) -> str:
     return result
 
 
-def _join(parts: List[str]) -> str:
-    # One Dask task: the print's tables from all parts, as JSON (what every batch is shipped).
-    result: str = _kappe.buildability_mc_tables_join(parts)
+def _collapse(text: str) -> str:
+    # One Dask task beside the parts: the collapse tables of a spec with [analysis.nonlinear]
+    # (the deterministic states, then the paths of the layer counts the state rule keeps), as
+    # JSON; ``null`` without it.
+    result: str = _kappe.buildability_mc_collapse_tables(text)
+    return result
+
+
+def _join(parts: List[str], collapse: str) -> str:
+    # One Dask task: the print's tables from all parts and the collapse tables, as JSON (what
+    # every batch is shipped).
+    result: str = _kappe.buildability_mc_tables_join(parts, collapse)
     return result
 
 
@@ -51,7 +61,8 @@ def buildability_monte_carlo(
     ``state_pf``, failure-layer mean and std; ``seconds`` and ``resolves`` are 0, they belong
     to the workers). Locally one batch runs on the Rust threads (the GIL released); with
     ``client`` the run is cut into ``batches`` (default: two per worker) tasks, after the tasks
-    that build the tables for them all (two parts per worker, then one that joins them)."""
+    that build the tables for them all (two parts per worker and, with ``[analysis.nonlinear]``,
+    the collapse tables; then one task that joins them)."""
     text, _, _ = read_source(spec, "buildability")
     parts: List[str]
     if client is None:
@@ -62,7 +73,8 @@ def buildability_monte_carlo(
         n = batches or 2 * workers
         k = 2 * workers
         table_parts = client.map(_table_part, [text] * k, list(range(k)), [k] * k, pure=False)
-        tables = client.submit(_join, table_parts, pure=False)
+        collapse = client.submit(_collapse, text, pure=False)
+        tables = client.submit(_join, table_parts, collapse, pure=False)
         futures = client.map(
             _batch, [text] * n, [samples] * n, [seed] * n, list(range(n)), [n] * n, [tables] * n, pure=False
         )

@@ -65,6 +65,39 @@ def test_dask_batches_equal_the_local_run(spec):
     assert comparable(on_dask) == comparable(local)
 
 
+NONLINEAR = """
+[analysis.nonlinear]
+
+[uncertainty]
+"analysis.nonlinear.imperfection" = { dist = "lognormal", cov = 0.5 }
+"material.time.youngs_modulus" = { dist = "lognormal", cov = 0.15 }
+"material.specific_weight" = { dist = "normal", cov = 0.02 }
+seed = 2
+monte_carlo = 2000
+"""
+
+
+def test_the_collapse_is_sampled_locally_and_on_dask_as_by_the_cli(tmp_path, spec, kappe_bin):
+    # With [analysis.nonlinear] and the imperfection uncertain, the collapse is a limit state of
+    # every tabulated layer count: the Python run (collapse tables built from the deterministic
+    # states, as the CLI builds them) and the Dask run (the collapse tables one more task,
+    # shipped with the linear tables) equal `kappe buildability`'s Monte Carlo.
+    distributed = pytest.importorskip("distributed")
+    f = tmp_path / "nonlinear.toml"
+    f.write_text(spec.read_text().split("[uncertainty]")[0] + NONLINEAR)
+    out = tmp_path / "out"
+    subprocess.run([kappe_bin, "buildability", str(f), "--out", str(out), "--quiet"], check=True)
+    result = json.loads((out / "buildability.json").read_text())["result"]
+    assert result["collapse_reliability"]["states"], "some layer count has a collapse table"
+    cli = result["monte_carlo"]
+    local = kappe.buildability_monte_carlo(f, 2000, seed=2)
+    assert comparable(local) == comparable(cli)
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True) as cluster:
+        with distributed.Client(cluster) as client:
+            on_dask = kappe.buildability_monte_carlo(f, 2000, seed=2, client=client, batches=3)
+    assert comparable(on_dask) == comparable(cli)
+
+
 def test_a_spec_without_uncertainty_is_a_design_error(spec):
     text = spec.read_text().split("[uncertainty]")[0]
     with pytest.raises(kappe.DesignError) as e:

@@ -15,7 +15,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use kappe::commands::buildability::{BuildabilitySpec, Resolved};
 use kappe::commands::buildability_reliability::{
-    Surrogate, SurrogateTables, monte_carlo_batch, monte_carlo_result, prepare, table_part_layers,
+    Surrogate, SurrogateTables, collapse_tables, monte_carlo_batch, monte_carlo_result, prepare,
+    table_part_layers,
 };
 use kappe_reliability::{Batch, EventBatch, SamplingOptions};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -45,7 +46,12 @@ fn tables(text: &str, shipped: Option<&str>) -> PyResult<Tables> {
                 serde_json::from_str(json).map_err(|e| json_err("Monte Carlo tables", e))?;
             Surrogate::from_tables(&r, text, prepared, t)
         }
-        None => Surrogate::build(&r, prepared),
+        // Built here: the linear tables and, with [analysis.nonlinear], the collapse tables
+        // from the deterministic states, as `kappe buildability` builds them.
+        None => Surrogate::build(&r, prepared).and_then(|mut sur| {
+            sur.collapse = collapse_tables(&r, &sur.prepared)?;
+            Ok(sur)
+        }),
     }
     .map_err(|e| design_error(&e))?;
     let t = Arc::new((r, sur));
@@ -102,15 +108,42 @@ pub(crate) fn buildability_mc_table_part(
     })
 }
 
-/// The tables of the print from the JSON of its parts (`buildability_mc_table_part`, any
-/// order), as JSON to ship to the processes that sample (`buildability_mc_batch`'s `tables`).
+/// The collapse tables of the buildability spec `text` (`collapse_tables`: the deterministic
+/// states, then the tables of the layer counts the state rule keeps), as JSON (`null` without
+/// `[analysis.nonlinear]`): one worker's task beside the table parts, joined by
+/// `buildability_mc_tables_join`.
 #[pyfunction]
-pub(crate) fn buildability_mc_tables_join(parts: Vec<String>) -> PyResult<String> {
+pub(crate) fn buildability_mc_collapse_tables(py: Python<'_>, text: &str) -> PyResult<String> {
+    let text = text.to_owned();
+    py.detach(move || -> PyResult<String> {
+        let (r, table) = resolved(&text)?;
+        let prepared = prepare(&r, &table).map_err(|e| design_error(&e))?;
+        let c = collapse_tables(&r, &prepared).map_err(|e| design_error(&e))?;
+        serde_json::to_string(&c).map_err(|e| json_err("collapse tables", e))
+    })
+}
+
+/// The tables of the print from the JSON of its parts (`buildability_mc_table_part`, any
+/// order) and of its collapse tables (`buildability_mc_collapse_tables`; required with
+/// `[analysis.nonlinear]`, where the batches refuse tables without them), as JSON to ship to
+/// the processes that sample (`buildability_mc_batch`'s `tables`).
+#[pyfunction]
+#[pyo3(signature = (parts, collapse=None))]
+pub(crate) fn buildability_mc_tables_join(
+    parts: Vec<String>,
+    collapse: Option<String>,
+) -> PyResult<String> {
     let parsed = parts
         .iter()
         .map(|p| serde_json::from_str::<SurrogateTables>(p).map_err(|e| json_err("table part", e)))
         .collect::<PyResult<Vec<_>>>()?;
-    let all = SurrogateTables::join(parsed).map_err(|e| design_error(&e))?;
+    let collapse = match collapse {
+        Some(c) => serde_json::from_str(&c).map_err(|e| json_err("collapse tables", e))?,
+        None => None,
+    };
+    let all = SurrogateTables::join(parsed)
+        .map_err(|e| design_error(&e))?
+        .with_collapse(collapse);
     serde_json::to_string(&all).map_err(|e| json_err("Monte Carlo tables", e))
 }
 

@@ -70,6 +70,10 @@ fn _kappe(m: &Bound<'_, PyModule>) -> PyResult<()> {
         buildability::buildability_mc_tables_join,
         m
     )?)?;
+    m.add_function(wrap_pyfunction!(
+        buildability::buildability_mc_collapse_tables,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_batch, m)?)?;
     m.add_function(wrap_pyfunction!(buildability::buildability_mc_merge, m)?)?;
     m.add_function(wrap_pyfunction!(design_mc::design_mc_plan, m)?)?;

@@ -33,7 +33,7 @@ use crate::input::error::DesignError;
 use crate::input::material::TimeModel;
 
 /// What ended a state's path at its collapse factor.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CollapseMode {
     /// The path reached a limit point (load maximum or bifurcation): buckling.

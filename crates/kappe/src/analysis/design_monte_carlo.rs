@@ -1120,6 +1120,20 @@ pub(crate) mod bits {
             .collect())
     }
 
+    /// A pair of numbers (a range).
+    pub mod pair {
+        use serde::{Deserialize, Deserializer, Serializer};
+
+        pub fn serialize<S: Serializer>(v: &[f64; 2], s: S) -> Result<S::Ok, S::Error> {
+            s.collect_seq(v.iter().map(|x| x.to_bits()))
+        }
+
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+            let [a, b] = <[u64; 2]>::deserialize(d)?;
+            Ok([f64::from_bits(a), f64::from_bits(b)])
+        }
+    }
+
     /// One number.
     pub mod one {
         use serde::{Deserialize, Deserializer, Serializer};

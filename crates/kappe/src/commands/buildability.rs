@@ -714,16 +714,17 @@ pub fn check_layers_cached(
 /// One chain's states of a round and its last mode.
 type ChainPart = (Vec<BuildState>, Option<ModeStart>);
 
-/// Check every layer count 1, 2, … up to `max_layers` (or the first failure when
-/// `stop_at_failure`). `on_state(n)` is called after each.
+/// The deterministic states of [`run`]: every layer count 1, 2, … up to `max_layers` (or the
+/// first failure when `stop_at_failure`), `on_state(n)` called after each; the chains as
+/// [`run`] describes. The buildability Monte Carlo's collapse tables are built from these
+/// (`buildability_reliability::collapse_tables`), on a Dask worker as in `run`.
 ///
-/// The layer counts run in `c` interleaved chains (c = the worker threads): chain i checks
-/// n = i + 1, i + 1 + c, …, each started from the previous mode of its chain (a state with c
-/// fewer layers, whose mode is close): the chains' costs are equal and each eigensolve needs
-/// a few Lanczos steps instead of ~20 (`cargo run --release -p kappe --example
-/// buildability`). With `stop_at_failure` the chains advance in rounds of c states and stop
-/// after the round with the first failure.
-pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildability, DesignError> {
+/// # Errors
+/// A failed solve.
+pub fn layer_states(
+    r: &Resolved,
+    on_state: &(dyn Fn(usize) + Sync),
+) -> Result<Vec<BuildState>, DesignError> {
     let max = r.spec.object.max_layers;
     let stop = r.spec.checks.stop_at_failure;
     let chains = rayon::current_num_threads().clamp(1, max);
@@ -770,6 +771,20 @@ pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildabili
         states.extend(part);
         next = hi + 1;
     }
+    Ok(states)
+}
+
+/// Check every layer count 1, 2, … up to `max_layers` (or the first failure when
+/// `stop_at_failure`). `on_state(n)` is called after each.
+///
+/// The layer counts run in `c` interleaved chains (c = the worker threads): chain i checks
+/// n = i + 1, i + 1 + c, …, each started from the previous mode of its chain (a state with c
+/// fewer layers, whose mode is close): the chains' costs are equal and each eigensolve needs
+/// a few Lanczos steps instead of ~20 (`cargo run --release -p kappe --example
+/// buildability`). With `stop_at_failure` the chains advance in rounds of c states and stop
+/// after the round with the first failure.
+pub fn run(r: &Resolved, on_state: &(dyn Fn(usize) + Sync)) -> Result<Buildability, DesignError> {
+    let mut states = layer_states(r, on_state)?;
     let (reliability, monte_carlo, collapse_reliability) = match &r.spec.uncertainty {
         Some(table) => {
             let (rel, mc, col) =

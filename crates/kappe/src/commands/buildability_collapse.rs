@@ -90,12 +90,12 @@ use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use kappe_reliability::{EvalError, Fallible, FormResult, LimitState};
 
 use crate::analysis::collapse::{Collapse, CollapseMode};
-use crate::analysis::design_monte_carlo::{bary_into, cheb};
+use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
 use crate::commands::buildability::{BuildState, Resolved, check_layers};
 use crate::commands::buildability_reliability::{
     E0, F0, FRATE, GAMMA, PARAMETERS, Prepared, RATE, T, Z_RANGE, resolved_at, t_hours,
@@ -240,36 +240,47 @@ pub fn direct(r: &Resolved, n: usize, p: &[f64; 6], m: f64) -> Result<Collapse, 
     })
 }
 
-/// One axis of the tables: ln of its variable over the box.
-#[derive(Debug, Clone)]
+/// One axis of the tables: ln of its variable over the box. Numbers travel as their bit
+/// patterns when shipped (`SurrogateTables`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct Axis {
     param: Option<usize>,
     var: usize,
+    #[serde(with = "bits")]
     nodes: Vec<f64>,
+    #[serde(with = "bits")]
     weights: Vec<f64>,
+    #[serde(with = "bits::pair")]
     range: [f64; 2],
 }
 
 /// One layer count's table: ln λ_c at γ₀ on the grid (the first axis slowest).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 struct StateTable {
     layers: usize,
+    #[serde(with = "bits")]
     log: Vec<f64>,
     modes: Vec<CollapseMode>,
 }
 
-/// The collapse tables of a buildability print (module docs).
-#[derive(Debug)]
+/// The collapse tables of a buildability print (module docs). Serializable with every number
+/// as its bit pattern, so that the tables built once on a Dask worker
+/// (`buildability_reliability::collapse_tables`) sample the same bits wherever they are
+/// shipped (`SurrogateTables`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CollapseTables {
     axes: Vec<Axis>,
     states: Vec<StateTable>,
     /// Layer counts whose nominal λ_c is 0 (mechanisms): they fail in every sample.
     mechanisms: Vec<usize>,
+    #[serde(with = "bits::one")]
     gamma0: f64,
+    #[serde(with = "bits::one")]
     collapse_min: f64,
     /// Whether a random variable enters λ_c (else no FORM component: deterministic).
     random: bool,
     /// The largest downward span D measured (module docs).
+    #[serde(with = "bits::one")]
     pub span: f64,
     /// Paths solved for the tables.
     pub solves: usize,

@@ -336,8 +336,8 @@ pub struct Surrogate {
     pub fallbacks: std::sync::atomic::AtomicU64,
     /// Wall-clock seconds of building the tables.
     pub build_seconds: f64,
-    /// The collapse factor's tables (with `[analysis.nonlinear]`; set by [`analyse`], not
-    /// shipped with [`SurrogateTables`]).
+    /// The collapse factor's tables (with `[analysis.nonlinear]`; set by [`analyse`] from the
+    /// run's states, or by [`collapse_tables`]; shipped with [`SurrogateTables`]).
     pub collapse: Option<CollapseTables>,
 }
 
@@ -363,6 +363,11 @@ pub struct SurrogateTables {
     #[serde(with = "bits")]
     phi: Vec<f64>,
     build_seconds: f64,
+    /// The collapse tables (with `[analysis.nonlinear]`; [`collapse_tables`], attached by
+    /// [`SurrogateTables::with_collapse`]): a nonlinear spec's tables without them are refused
+    /// ([`Surrogate::from_tables`]), so that no sample silently leaves out the collapse.
+    #[serde(default)]
+    collapse: Option<CollapseTables>,
 }
 
 /// The layer counts of part `index` of `count` of the tables of a `max`-layer print, for
@@ -436,9 +441,40 @@ impl SurrogateTables {
             }
             all.states.extend(p.states);
             all.build_seconds += p.build_seconds;
+            if all.collapse.is_none() {
+                all.collapse = p.collapse;
+            }
         }
         Ok(all)
     }
+
+    /// These tables with the print's collapse tables ([`collapse_tables`], built on their own
+    /// worker beside the parts).
+    #[must_use]
+    pub fn with_collapse(mut self, collapse: Option<CollapseTables>) -> SurrogateTables {
+        self.collapse = collapse;
+        self
+    }
+}
+
+/// The collapse tables of a buildability spec with `[analysis.nonlinear]` (None without it),
+/// as [`analyse`] builds them: from the deterministic states of [`run`]
+/// ([`crate::commands::buildability::layer_states`]), so that a Monte Carlo outside `run`
+/// (Python, a Dask worker) counts the collapse as `kappe buildability` does.
+///
+/// # Errors
+/// A failed solve or path; see [`CollapseTables::build`].
+///
+/// [`run`]: crate::commands::buildability::run
+pub fn collapse_tables(
+    r: &Resolved,
+    prepared: &Prepared,
+) -> Result<Option<CollapseTables>, DesignError> {
+    if r.spec.nonlinear().is_none() {
+        return Ok(None);
+    }
+    let states = crate::commands::buildability::layer_states(r, &|_| {})?;
+    CollapseTables::build(r, prepared, &states).map(Some)
 }
 
 /// Print time of the state with n layers, h.
@@ -648,6 +684,7 @@ impl Surrogate {
             first: self.first,
             phi: vec![self.sin_phi, self.cos_phi],
             build_seconds: self.build_seconds,
+            collapse: self.collapse.clone(),
         }
     }
 
@@ -679,6 +716,14 @@ impl Surrogate {
                 tables.states.len()
             )));
         }
+        if r.spec.nonlinear().is_some() && tables.collapse.is_none() {
+            return Err(bad(
+                "the spec has [analysis.nonlinear] and the tables have no collapse tables \
+                 (build them with collapse_tables and attach them with \
+                 SurrogateTables::with_collapse): sampling without them would leave the \
+                 collapse out",
+            ));
+        }
         Ok(Surrogate {
             prepared,
             nodes: tables.nodes,
@@ -692,7 +737,7 @@ impl Surrogate {
             cos_phi: *cos_phi,
             fallbacks: std::sync::atomic::AtomicU64::new(0),
             build_seconds: tables.build_seconds,
-            collapse: None,
+            collapse: tables.collapse,
         })
     }
 

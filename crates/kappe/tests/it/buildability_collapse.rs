@@ -11,7 +11,7 @@ use kappe::commands::buildability_collapse::{
     CollapseTables, DESIGN_POINT_BETA_TOLERANCE, IMPERFECTION, direct,
 };
 use kappe::commands::buildability_reliability::{
-    Surrogate, example_spec, prepare, reliability_with_points,
+    Surrogate, collapse_tables, example_spec, monte_carlo, prepare, reliability_with_points,
 };
 use kappe::input::DesignError;
 use kappe_reliability::{Batch, SamplingOptions, sample_events};
@@ -218,6 +218,48 @@ fn run_with_an_uncertain_imperfection_reports_the_collapse_limit_state() {
     assert!(mc.pf > 0.5, "{mc:?}");
     let doc = kappe::commands::buildability::document(&r, &b);
     assert!(doc["result"]["collapse_reliability"]["max_beta_error"].is_number());
+
+    // The Monte Carlo outside `run` (Python, Dask): the collapse tables built by
+    // `collapse_tables` from the same deterministic states and shipped as JSON with the linear
+    // tables give `run`'s Monte Carlo bit for bit (every field but the timings and the
+    // re-solve count, which belong to the process); tables shipped without them are refused
+    // for this nonlinear spec, never sampled without the collapse.
+    let text = small("", &scatter(2, true));
+    let mut spec = BuildabilitySpec::parse(&text).unwrap();
+    let table = spec.uncertainty.take().unwrap();
+    let mut sur = Surrogate::build(&r, prepare(&r, &table).unwrap()).unwrap();
+    let linear_only = serde_json::to_string(&sur.tables(&text)).unwrap();
+    let refused = Surrogate::from_tables(
+        &r,
+        &text,
+        prepare(&r, &table).unwrap(),
+        serde_json::from_str(&linear_only).unwrap(),
+    )
+    .err()
+    .unwrap();
+    assert!(refused.to_string().contains("collapse"), "{refused}");
+    let collapse = collapse_tables(&r, &sur.prepared).unwrap();
+    assert_eq!(
+        collapse.as_ref().map(CollapseTables::layers),
+        Some(c.states.clone()),
+        "the same layer counts tabulated as in run"
+    );
+    let json = serde_json::to_string(&sur.tables(&text).with_collapse(collapse.clone())).unwrap();
+    sur.collapse = collapse;
+    let shipped = Surrogate::from_tables(
+        &r,
+        &text,
+        prepare(&r, &table).unwrap(),
+        serde_json::from_str(&json).unwrap(),
+    )
+    .unwrap();
+    for s in [&sur, &shipped] {
+        let m = monte_carlo(&r, s, mc.samples, mc.seed).unwrap();
+        assert_eq!(
+            (&m.state_pf, &m.failed_by, m.pf, m.pf_interval),
+            (&mc.state_pf, &mc.failed_by, mc.pf, mc.pf_interval)
+        );
+    }
 }
 
 #[test]
