@@ -272,6 +272,9 @@ pub struct CapStateTable {
     /// Whether a grid path reached λ_max or stopped converging without a limit point (its
     /// value a lower bound).
     pub bounded: bool,
+    /// What ended each grid path (`CollapseMode::name`; the deterministic λ_c's mode without
+    /// axes).
+    pub modes: Vec<String>,
 }
 
 /// A cap's collapse tables (module docs): plain data, shipped to the design Monte Carlo's
@@ -579,6 +582,7 @@ impl<'a> CapCollapseModel<'a> {
                             log: vec![g + collapse_min.ln()],
                             mixed: false,
                             bounded: false,
+                            modes: Vec::new(),
                         },
                     )
                 })
@@ -670,6 +674,7 @@ impl<'a> CapCollapseModel<'a> {
                         bounded: c.iter().any(|v| {
                             matches!(v.1, CollapseMode::NotReached | CollapseMode::NoConvergence)
                         }),
+                        modes: c.iter().map(|v| v.1.name().to_owned()).collect(),
                     },
                 )
             })
@@ -862,12 +867,27 @@ pub struct CapCollapseReliability {
     pub solves: usize,
     /// Wall-clock seconds of the tables.
     pub seconds: f64,
+    /// Every tabulated state's grid: λ_c at γ₀, E₀ per point and what ended its path.
+    pub grids: Vec<CollapseGrid>,
     /// Every state's collapse design point against a direct path.
     pub design_points: Vec<DesignPointCheck>,
     /// The largest relative error there.
     pub max_relative_error: f64,
     /// The largest error there as Δβ.
     pub max_beta_error: f64,
+}
+
+/// One tabulated state's grid (the first axis slowest).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct CollapseGrid {
+    /// State index.
+    pub state: usize,
+    /// The axes' values per point.
+    pub points: Vec<Vec<f64>>,
+    /// λ_c per point (at γ₀, E₀).
+    pub factors: Vec<f64>,
+    /// What ended each path.
+    pub modes: Vec<String>,
 }
 
 impl CapCollapseReliability {
@@ -903,6 +923,20 @@ impl CapCollapseReliability {
             span: tables.span,
             solves: tables.solves,
             seconds: tables.seconds,
+            grids: tables
+                .states
+                .iter()
+                .filter(|s| !s.modes.is_empty())
+                .map(|s| {
+                    let grids: Vec<LogAxis> = tables.axes.iter().map(|a| a.grid.clone()).collect();
+                    CollapseGrid {
+                        state: s.index,
+                        points: (0..s.log.len()).map(|j| grid_point(&grids, j)).collect(),
+                        factors: s.log.iter().map(|l| l.exp()).collect(),
+                        modes: s.modes.clone(),
+                    }
+                })
+                .collect(),
             max_relative_error: checks.iter().map(|c| c.relative_error).fold(0.0, f64::max),
             max_beta_error: checks.iter().map(|c| c.beta_error).fold(0.0, f64::max),
             design_points: checks,
