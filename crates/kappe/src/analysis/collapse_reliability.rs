@@ -50,11 +50,14 @@
 //! its margin smaller than it is and so admits more states (the safe side); a tabulated
 //! `not_reached` state gets real paths (`above = ∞`). Then the buildability rule
 //! ([`admit`]): the least-margin state first, its downward span D measured on its interpolant
-//! over the ±[`Z_SELECT`] box, every state with G_q ≤ [`SPAN_SAFETY`]·D_max added, repeated.
-//! The exactly scaled variables shift every state's ln λ_c by the same amount
-//! (ln(E/E₀) − ln(γ/γ₀)), so that part of every span is the same, known exactly; only the
-//! table axes' part differs between states, and that is the part the rule measures on
-//! neighbours rather than proves. Without a table axis the rule is exact: every g_q is
+//! over the ±[`Z_SELECT`] box, every state with G_q ≤ S + [`SPAN_SAFETY`]·D_max added,
+//! repeated. S is the downward shift of ln λ_c by the exactly scaled variables at their worst
+//! over the box (ln(γ_hi/γ₀) + ln(E₀/E_lo)): they shift every state's ln λ_c by the same
+//! amount, so that part of every span is the same and known exactly, and takes no safety
+//! factor; only the table axes' span D differs between states, and that is the part the rule
+//! measures on neighbours rather than proves. A state q can fail inside the box only if
+//! G_q ≤ S + D_q; a skipped state has G_q > S + 1.5·D_max, so it could only if its own table
+//! span exceeded 1.5× every span measured on the same cap. Without a table axis the rule is exact: every g_q is
 //! G_q + the same shift, the least-G state fails first in every sample, and every state with a
 //! collapse factor gets its (exact, free) table.
 
@@ -218,14 +221,18 @@ pub fn least_log(axes: &[LogAxis], log: &[f64], select: &[[f64; 2]]) -> f64 {
 
 /// The state rule (module docs): `order` = (state, G) ascending in G, the nominal ln-margins;
 /// `tabulate` the tables of some states; `least_g` the least g of a table over the selection
-/// box (the exactly scaled variables at their worst). The least-G state first, then every
-/// state with G ≤ [`SPAN_SAFETY`]·D_max (D = G − least g, the largest measured), repeated
-/// until none is added. Returns the tables (tabulation order) and D_max.
+/// box with the exactly scaled variables at their means; `exact` the downward shift S ≥ 0 of
+/// every state's ln λ_c by the exactly scaled variables at their worst over the box (the same
+/// for every state, known exactly). The least-G state first, then every state with
+/// G ≤ S + [`SPAN_SAFETY`]·D_max (D = G − least g, the tables' own span, the largest measured:
+/// the safety factor covers only what is measured on neighbours), repeated until none is
+/// added. Returns the tables (tabulation order) and D_max.
 ///
 /// # Errors
 /// `tabulate`'s.
 pub fn admit<T, E>(
     order: &[(usize, f64)],
+    exact: f64,
     mut tabulate: impl FnMut(&[usize]) -> Result<Vec<(usize, T)>, E>,
     least_g: impl Fn(&T) -> f64,
 ) -> Result<(Vec<(usize, T)>, f64), E> {
@@ -238,7 +245,7 @@ pub fn admit<T, E>(
             span = span.max(g - least_g(&t));
             out.push((n, t));
         }
-        let bound = SPAN_SAFETY * span;
+        let bound = exact + SPAN_SAFETY * span;
         next = order
             .iter()
             .filter(|&&(n, g)| g <= bound && !out.iter().any(|t| t.0 == n))
@@ -298,9 +305,14 @@ pub struct CapCollapseTables {
     pub collapse_min: f64,
     /// The tabulated states, in state order.
     pub states: Vec<CapStateTable>,
-    /// The largest downward span D measured (the state rule's).
+    /// The largest downward span D of a table measured (the state rule's; without axes the
+    /// exact shift).
     #[serde(with = "bits::one")]
     pub span: f64,
+    /// The downward shift S of every state's ln λ_c by the exactly scaled variables at their
+    /// worst over the selection box.
+    #[serde(with = "bits::one")]
+    pub exact_shift: f64,
     /// Paths solved for the tables.
     pub solves: usize,
     /// Wall-clock seconds of the tables.
@@ -591,14 +603,13 @@ impl<'a> CapCollapseModel<'a> {
         } else {
             admit(
                 &order,
+                exact_shift,
                 |states| {
                     let t = self.tabulate(&axes, states)?;
                     solves += t.len() * grid_size(&grids);
                     Ok::<_, DesignError>(t)
                 },
-                |t: &CapStateTable| {
-                    least_log(&grids, &t.log, &select) - collapse_min.ln() - exact_shift
-                },
+                |t: &CapStateTable| least_log(&grids, &t.log, &select) - collapse_min.ln(),
             )?
         };
         let mut states: Vec<CapStateTable> = states.into_iter().map(|s| s.1).collect();
@@ -612,6 +623,7 @@ impl<'a> CapCollapseModel<'a> {
             collapse_min,
             states,
             span,
+            exact_shift,
             solves,
             seconds: t0.elapsed().as_secs_f64(),
         }))
@@ -861,8 +873,11 @@ pub struct CapCollapseReliability {
     /// Tabulated states with a grid path that ended without collapse (λ_max reached or no
     /// convergence: a lower bound there).
     pub bounded: Vec<usize>,
-    /// The largest downward span of ln λ_c measured (the state rule's D).
+    /// The largest downward span of a table's ln λ_c measured (the state rule's D).
     pub span: f64,
+    /// The downward shift S of every state's ln λ_c by γ and E at their worst over the
+    /// selection box (exact; the rule admits states with G ≤ S + 1.5·D).
+    pub exact_shift: f64,
     /// Paths solved for the tables.
     pub solves: usize,
     /// Wall-clock seconds of the tables.
@@ -921,6 +936,7 @@ impl CapCollapseReliability {
                 .map(|s| s.index)
                 .collect(),
             span: tables.span,
+            exact_shift: tables.exact_shift,
             solves: tables.solves,
             seconds: tables.seconds,
             grids: tables
