@@ -1,6 +1,7 @@
 //! The collapse factor of the default cap as a limit state (issue 24), printed as a table:
-//! `cargo run --release -p kappe --example cap_collapse_reliability -- [LENGTH] [SAMPLES]`
-//! (defaults: the default cap's own length, 10⁴ samples; LENGTH in m for a shorter cap).
+//! `cargo run --release -p kappe --example cap_collapse_reliability -- [LENGTH] [SAMPLES] [METHOD]`
+//! (defaults: the default cap's own length (0 keeps it), 10⁴ samples, `crude`; LENGTH in m for a
+//! shorter cap; METHOD `importance` samples around the design point, for P_f far below 1/N).
 //!
 //! The default design (`kappe init`; robot planning off, which the reliability does not use)
 //! with `[analysis.nonlinear]` (no time model: the limit point only, w0 by the rule) and three
@@ -30,7 +31,8 @@ use kappe::analysis::collapse_reliability::CapCollapseModel;
 use kappe::input::IMPERFECTION;
 use kappe::{Design, Options, no_progress, run};
 use kappe_reliability::{
-    EvalError, Fallible, FormOptions, SamplingOptions, SormOptions, form, monte_carlo, sorm,
+    EvalError, Fallible, FormOptions, SamplingOptions, SormOptions, form, importance_sampling,
+    monte_carlo, sorm,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -42,6 +44,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(2)
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
+    let method = std::env::args()
+        .nth(3)
+        .unwrap_or_else(|| "crude".to_owned());
     let mut base = Design::default();
     if length > 0.0 {
         base.cap.length = length;
@@ -90,7 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "[uncertainty]\n\"{IMPERFECTION}\" = {{ dist = \"lognormal\", cov = 0.5 }}\n\
          \"material.youngs_modulus\" = {{ dist = \"lognormal\", cov = 0.15 }}\n\
          \"material.specific_weight\" = {{ dist = \"normal\", cov = 0.02 }}\n\
-         monte_carlo = {samples}\nmonte_carlo_method = \"crude\"\nseed = 1\n"
+         monte_carlo = {samples}\nmonte_carlo_method = \"{method}\"\nseed = 1\n"
     );
     #[derive(serde::Deserialize)]
     struct U {
@@ -125,7 +130,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let m = CapCollapseModel::new(&out.cap, &a.options, &out.schedule, &model)?
         .ok_or("no collapse model")?;
     println!(
-        "\n| state | nominal λ_c | β FORM | P_f FORM | P_f SORM | P_f Monte Carlo (N = {samples}) [Wilson 95 %] |"
+        "\n| state | nominal λ_c | β FORM | P_f FORM | P_f SORM | P_f Monte Carlo ({method}, N = {samples}) [95 %] |"
     );
     println!("|---|---|---|---|---|---|");
     for s in &tables.states {
@@ -148,9 +153,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 .sample_g(&m, s.index, x, &fallbacks)
                 .map_err(|e| EvalError::from(e.to_string()))
         });
-        let mc = monte_carlo(&sm, &mut gs, &SamplingOptions::new(samples, 1))?;
+        let options = SamplingOptions::new(samples, 1);
+        let mc = if method == "importance" {
+            importance_sampling(&sm, &mut gs, &f.u_star, &options)?
+        } else {
+            monte_carlo(&sm, &mut gs, &options)?
+        };
         println!(
-            "| {} | {nominal:.4} | {:.3} | {:.4} | {:.4} | {:.4} [{:.4}, {:.4}] ({} re-solved) |",
+            "| {} | {nominal:.4} | {:.3} | {:.4e} | {:.4e} | {:.4e} [{:.4e}, {:.4e}] ({} re-solved) |",
             s.index,
             f.beta,
             f.pf,
@@ -163,8 +173,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Some(mc) = &r.monte_carlo {
         println!(
-            "\nprint: FORM P_f {:.4} (β {:.3}, governing {} {}), SORM {:?}; design Monte Carlo \
-             {:.4} [{:.4}, {:.4}] over states {:?}, {} re-solved",
+            "\nprint: FORM P_f {:.4e} (β {:.3}, governing {} {}), SORM {:?}; design Monte Carlo \
+             ({method}) {:.4e} [{:.4e}, {:.4e}] over states {:?}, {} re-solved",
             r.pf,
             r.beta,
             r.governing_state,
