@@ -635,13 +635,7 @@ pub fn cap_state_collapse_from(
         }));
     };
     let mode = &mode;
-    let (zmin, zmax) = model
-        .nodes
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p[2]), b.max(p[2]))
-        });
-    let w0 = spec.amplitude(model.thickness_of(0), (zmax - zmin).max(0.0));
+    let w0 = state_amplitude(spec, model);
     let start;
     // From the design, the path's model is the LBA's, and so is its linear static solution
     // (one factorization of K fewer per state).
@@ -697,6 +691,20 @@ pub fn cap_state_collapse_from(
         },
     )
     .map(Some)
+}
+
+/// The imperfection amplitude w0 of a cap state's path on its shell `model`: `spec`'s
+/// `imperfection`, else the rule with the shell's thickness and the state's height above its
+/// lowest node ([`crate::input::nonlinear::NonlinearSpec::amplitude`]). The collapse limit
+/// state's factor on the rule's w0 multiplies this (`analysis::collapse_reliability`).
+pub fn state_amplitude(spec: &crate::input::nonlinear::NonlinearSpec, model: &ShellModel) -> f64 {
+    let (zmin, zmax) = model
+        .nodes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p[2]), b.max(p[2]))
+        });
+    spec.amplitude(model.thickness_of(0), (zmax - zmin).max(0.0))
 }
 
 /// `model` with every node moved by `shift` (m).

@@ -26,6 +26,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 
+use super::collapse_reliability::{CapCollapseModel, CapCollapseTables};
 use super::reliability::{
     Check, FAR_BETA, GreenField, RESOLVE_TOLERANCE, Reliability, TimeBuckling, Vars, limit_state,
     scaled_ages, screen_delta, state_checks, time_buckling_g,
@@ -203,6 +204,9 @@ pub struct GovState {
     pub beta: f64,
     /// Its random checks.
     pub checks: Vec<McCheck>,
+    /// Whether it has a collapse component ([`McPlan::collapse`]'s table).
+    #[serde(default)]
+    pub collapse: bool,
 }
 
 /// What the Monte Carlo samples: [`plan`]'s output.
@@ -225,6 +229,11 @@ pub struct McPlan {
     pub excluded_share: f64,
     /// The governing states, in state order.
     pub states: Vec<GovState>,
+    /// The collapse tables of the design's states (`[analysis.nonlinear]` with
+    /// `[uncertainty]`, [`super::collapse_reliability`]), shipped with the plan so that every
+    /// worker samples the same tables.
+    #[serde(default)]
+    pub collapse: Option<CapCollapseTables>,
 }
 
 /// λ of one state tabulated: ln Λ at the Chebyshev points of ln ρ (× s), Λ = λ/E₀.
@@ -317,6 +326,7 @@ pub struct McContext<'a> {
     drifts: Vec<(String, Drift)>,
     vars: Vars,
     time: Option<TimeModel>,
+    collapse: Option<CapCollapseModel<'a>>,
 }
 
 fn uerr(message: String) -> DesignError {
@@ -347,10 +357,12 @@ impl<'a> McContext<'a> {
         } else {
             None
         };
+        let collapse = CapCollapseModel::new(cap, options, schedule, &model)?;
         Ok(McContext {
             cap,
             options,
             schedule,
+            collapse,
             model,
             drifts: table.drifts(),
             vars,
@@ -413,10 +425,13 @@ pub fn plan(
     }
     let mut chosen: Vec<usize> = ranked.iter().take(keep).map(|(_, s)| s.index).collect();
     chosen.sort_unstable();
+    let collapse = r.collapse_tables.clone();
+    let has_collapse = |i: usize| collapse.as_ref().is_some_and(|t| t.has(i));
     let states = per_state
         .into_iter()
-        .filter(|(i, _, c)| chosen.contains(i) && !c.is_empty())
+        .filter(|(i, _, c)| chosen.contains(i) && (!c.is_empty() || has_collapse(*i)))
         .map(|(index, t_hours, checks)| GovState {
+            collapse: has_collapse(index),
             index,
             t_hours,
             beta: r
@@ -440,6 +455,7 @@ pub fn plan(
         sorm_pf: r.sorm.as_ref().map(|s| s.pf),
         excluded_share: if r.pf > 0.0 { excluded / r.pf } else { 0.0 },
         states,
+        collapse,
     })
 }
 
@@ -478,6 +494,57 @@ pub(crate) fn bary_into(nodes: &[f64], weights: &[f64], s: f64, out: &mut [f64])
         sum += *c;
     }
     out.iter_mut().for_each(|c| *c /= sum);
+}
+
+/// Most points per axis of any table that [`bary_continued`] continues (the buildability
+/// objects' 9, the collapse tables' 5, this module's [`RHO_NODES`]).
+pub(crate) const MAX_TABLE_NODES: usize = 17;
+
+/// The barycentric coefficients at s outside the range [lo, hi] of `nodes`, for FORM only:
+/// the tables (all logarithms) continued as straight lines in s from the nearer edge (C¹;
+/// power laws in the variable), so that FORM's far iterates see a smooth surface. `out` is as
+/// long as `nodes` (at most [`MAX_TABLE_NODES`]).
+fn bary_continued(nodes: &[f64], weights: &[f64], [lo, hi]: [f64; 2], s: f64, out: &mut [f64]) {
+    let k = nodes.len().min(MAX_TABLE_NODES);
+    let (e, inner) = if s < lo {
+        (lo, lo + 1e-3 * (hi - lo))
+    } else {
+        (hi, hi - 1e-3 * (hi - lo))
+    };
+    let mut ce = [0.0; MAX_TABLE_NODES];
+    let mut ci = [0.0; MAX_TABLE_NODES];
+    bary_into(nodes, weights, e, &mut ce[..k]);
+    bary_into(nodes, weights, inner, &mut ci[..k]);
+    let t = (s - e) / (e - inner);
+    for (j, c) in out.iter_mut().enumerate().take(k) {
+        *c = ce[j] + (ce[j] - ci[j]) * t;
+    }
+}
+
+/// The barycentric coefficients of a table axis over `[lo, hi]` at s, into `out`: inside the
+/// range the interpolant's; outside it, with `clamp` (FORM), the straight continuation of
+/// [`bary_continued`], s held at 10³ box widths beyond the edge (FORM's far iterates, where
+/// x → 0 or ∞ underflows the logarithm, stay finite so FORM reports a far β instead of failing
+/// on an evaluation). `false` when s is outside without `clamp` (or NaN): the caller falls back
+/// to a direct solve and counts it.
+pub(crate) fn table_coefficients(
+    nodes: &[f64],
+    weights: &[f64],
+    [lo, hi]: [f64; 2],
+    s: f64,
+    clamp: bool,
+    out: &mut [f64],
+) -> bool {
+    if (lo..=hi).contains(&s) {
+        bary_into(nodes, weights, s, out);
+        true
+    } else if clamp && !s.is_nan() {
+        let far = 1e3 * (hi - lo);
+        bary_continued(nodes, weights, [lo, hi], s.clamp(lo - far, hi + far), out);
+        true
+    } else {
+        false
+    }
 }
 
 /// [`bary_into`] into a new vector.
@@ -743,6 +810,7 @@ fn components<'a>(
     plan: &'a McPlan,
     fields: &'a [Option<GreenField>],
     resolved: &'a AtomicU64,
+    clamp: bool,
 ) -> Result<Vec<StateComponents<'a>>, DesignError> {
     let k = &ctx.cap.design.constraints;
     let limits = (k.sigma_min, k.sigma_max, k.blf_min);
@@ -775,6 +843,25 @@ fn components<'a>(
                     Ok(limit_state(check, v, limits, x, &mut []))
                 }))),
             }
+        }
+        // The collapse component on its table: FORM's continuation outside the box for the
+        // importance-sampling centres (`clamp`), a direct path there for a sample (counted).
+        if s.collapse {
+            let (Some(m), Some(t)) = (&ctx.collapse, &plan.collapse) else {
+                return Err(uerr(format!(
+                    "state {}: a collapse component without its table or the collapse check",
+                    s.index
+                )));
+            };
+            let index = s.index;
+            comps.push(if clamp {
+                Box::new(Fallible(move |x: &[f64]| t.g(m, index, x)))
+            } else {
+                Box::new(Fallible(move |x: &[f64]| {
+                    t.sample_g(m, index, x, resolved)
+                        .map_err(|e| EvalError::from(e.to_string()))
+                }))
+            });
         }
         out.push((model, comps));
     }
@@ -820,7 +907,7 @@ pub fn setup(
     if setup.plan.method == McMethod::Importance {
         let fields = fields(ctx, &setup.plan)?;
         let resolved = AtomicU64::new(0);
-        let states = components(ctx, &setup.tables, &setup.plan, &fields, &resolved)?;
+        let states = components(ctx, &setup.tables, &setup.plan, &fields, &resolved, true)?;
         let mut found: Vec<(f64, Vec<f64>)> = Vec::new();
         for (model, comps) in states {
             for mut g in comps {
@@ -915,7 +1002,7 @@ fn run_block(
 ) -> Result<McBlock, DesignError> {
     let plan = &setup.plan;
     let resolved = AtomicU64::new(0);
-    let mut states = components(ctx, &setup.tables, plan, fields, &resolved)?;
+    let mut states = components(ctx, &setup.tables, plan, fields, &resolved, false)?;
     let n = ctx.model.len();
     let mut rng = ChaCha8Rng::seed_from_u64(plan.seed);
     rng.set_stream(b);
@@ -1118,20 +1205,6 @@ pub(crate) mod bits {
             .into_iter()
             .map(f64::from_bits)
             .collect())
-    }
-
-    /// A pair of numbers (a range).
-    pub mod pair {
-        use serde::{Deserialize, Deserializer, Serializer};
-
-        pub fn serialize<S: Serializer>(v: &[f64; 2], s: S) -> Result<S::Ok, S::Error> {
-            s.collect_seq(v.iter().map(|x| x.to_bits()))
-        }
-
-        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-            let [a, b] = <[u64; 2]>::deserialize(d)?;
-            Ok([f64::from_bits(a), f64::from_bits(b)])
-        }
     }
 
     /// One number.

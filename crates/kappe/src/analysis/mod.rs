@@ -37,6 +37,7 @@ pub(crate) mod blf_sensitivity;
 pub(crate) mod buckling;
 pub(crate) mod check;
 pub(crate) mod collapse;
+pub mod collapse_reliability;
 pub(crate) mod convergence;
 pub mod design_monte_carlo;
 pub(crate) mod graded;
@@ -64,10 +65,10 @@ pub use check::{
     state_fe, state_fe_refine,
 };
 pub use collapse::{
-    CURVE_POINTS, CollapseMode, CollapseOptions, FirstPass, ObjectIncrements, StateLba,
+    CURVE_POINTS, Collapse, CollapseMode, CollapseOptions, FirstPass, ObjectIncrements, StateLba,
     cap_as_printed_shift, cap_state_collapse, cap_state_collapse_from, cap_state_lba,
     cap_state_lba_from, collapse_factor, object_as_printed_shift, object_as_printed_shift_cached,
-    shifted,
+    shifted, state_amplitude,
 };
 pub use graded::{Grading, coarsened_state, graded_rows, graded_state};
 pub use green::{

@@ -286,6 +286,15 @@ pub struct Reliability {
     /// `beta_min` verdict uses its β ([`Reliability::verdict`]). FORM's numbers above stay.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sorm: Option<SormSystem>,
+    /// The collapse limit state of the states (`[analysis.nonlinear]` with `[uncertainty]`):
+    /// its tables and every state's design point against a direct path
+    /// (`crate::analysis::collapse_reliability`). Absent without the collapse check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub collapse: Option<super::collapse_reliability::CapCollapseReliability>,
+    /// The collapse tables themselves, for the design's Monte Carlo (not in the outputs).
+    #[serde(skip)]
+    #[schemars(skip)]
+    pub collapse_tables: Option<super::collapse_reliability::CapCollapseTables>,
 }
 
 impl Reliability {
@@ -351,22 +360,22 @@ impl Check {
 /// Indices of γ, E, ν in the model, and their analysed values.
 #[derive(Debug, Clone, Copy)]
 pub struct Vars {
-    gamma: Option<usize>,
-    e: Option<usize>,
-    nu: Option<usize>,
-    gamma0: f64,
-    e0: f64,
-    nu0: f64,
+    pub(crate) gamma: Option<usize>,
+    pub(crate) e: Option<usize>,
+    pub(crate) nu: Option<usize>,
+    pub(crate) gamma0: f64,
+    pub(crate) e0: f64,
+    pub(crate) nu0: f64,
     /// The time model's E₀ and Ė (`material.time.*`).
-    e0t: Option<usize>,
-    rate: Option<usize>,
+    pub(crate) e0t: Option<usize>,
+    pub(crate) rate: Option<usize>,
     /// The time model's strength at age 0 (f₀ or c₀), its rate and the friction angle (°).
-    f0: Option<usize>,
-    frate: Option<usize>,
-    phi: Option<usize>,
+    pub(crate) f0: Option<usize>,
+    pub(crate) frate: Option<usize>,
+    pub(crate) phi: Option<usize>,
     /// The print speed and its nominal value.
-    speed: Option<usize>,
-    speed0: f64,
+    pub(crate) speed: Option<usize>,
+    pub(crate) speed0: f64,
 }
 
 impl Vars {
@@ -1492,6 +1501,7 @@ pub fn state_form(
         t_hours,
         checks,
         None,
+        Vec::new(),
     )
 }
 
@@ -1515,8 +1525,9 @@ fn state_form_with<'a>(
     t_hours: f64,
     checks: &[Check],
     mut prebuilt: Option<Prebuilt<'a>>,
+    extra: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'a>)>,
 ) -> Result<Option<StateForm>, DesignError> {
-    if checks.is_empty() {
+    if checks.is_empty() && extra.is_empty() {
         return Ok(None);
     }
     let k = &cap.design.constraints;
@@ -1548,7 +1559,8 @@ fn state_form_with<'a>(
             .transpose()?,
         None => None,
     };
-    let mut named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = Vec::new();
+    // The collapse component (`collapse_reliability`), a named limit state like the others.
+    let mut named: Vec<(&'static str, Box<dyn kappe_reliability::LimitState + '_>)> = extra;
     let mut given = Vec::new();
     let mut first_order = false;
     for &check in checks {
@@ -2007,6 +2019,24 @@ pub fn reliability(
     let mut states = Vec::new();
     let prepared = (&model, drifts.as_slice(), v);
     let options = &analysis.options;
+    // The collapse limit state (`collapse_reliability`): tables of the states the rule
+    // admits, from the deterministic check's collapse factors.
+    let collapse_model =
+        super::collapse_reliability::CapCollapseModel::new(cap, options, schedule, &model)?;
+    let state_times: Vec<(usize, f64)> = per_state.iter().map(|p| (p.0, p.1)).collect();
+    let collapse_tables = match &collapse_model {
+        Some(m) => {
+            let times: Vec<f64> = state_times.iter().map(|p| p.1).collect();
+            let factors: Vec<(usize, f64)> = analysis
+                .states
+                .iter()
+                .filter_map(|s| s.collapse_factor.map(|f| (s.index, f)))
+                .collect();
+            m.build(&model, &drifts, &times, &factors)?
+        }
+        None => None,
+    };
+    let collapse_of = |index: usize| collapse_component(&collapse_model, &collapse_tables, index);
     let mut firsts = if table.screening.unwrap_or(true) {
         first_orders(cap, options, schedule, prepared, &per_state)?
     } else {
@@ -2036,6 +2066,7 @@ pub fn reliability(
             *t_hours,
             checks,
             prebuild(f.take(), false),
+            collapse_of(*index),
         )?;
         let bound = done
             .iter()
@@ -2074,6 +2105,7 @@ pub fn reliability(
                 *t_hours,
                 checks,
                 prebuild(f, screen),
+                collapse_of(*index),
             )
         })
         .collect::<Result<Vec<_>, DesignError>>()?;
@@ -2093,7 +2125,37 @@ pub fn reliability(
                 .into(),
         });
     }
-    print_reliability(
+    // Every collapse design point against a direct path there (the table's error as Δβ).
+    let collapse = match (&collapse_model, &collapse_tables) {
+        (Some(m), Some(t)) => {
+            let points: Vec<(usize, f64, &FormResult)> = results
+                .iter()
+                .filter(|c| c.1 == "collapse")
+                .map(|c| {
+                    let th = state_times.iter().find(|p| p.0 == c.0).map_or(0.0, |p| p.1);
+                    (c.0, th, &c.2)
+                })
+                .collect();
+            let checks = points
+                .par_iter()
+                .map(|&(index, th, f)| {
+                    let state_model =
+                        model
+                            .drifted(&drifts, th)
+                            .map_err(|e| DesignError::Uncertainty {
+                                field: "uncertainty.drift".into(),
+                                message: format!("state {index} at {th:.3} h: {e}"),
+                            })?;
+                    m.check_point(t, &state_model, index, f)
+                })
+                .collect::<Result<Vec<_>, DesignError>>()?;
+            Some(super::collapse_reliability::CapCollapseReliability::of(
+                m, t, checks,
+            ))
+        }
+        _ => None,
+    };
+    let mut r = print_reliability(
         results,
         states,
         &SystemOptions {
@@ -2103,8 +2165,28 @@ pub fn reliability(
         },
         k.beta_min.unwrap_or(BETA_MIN_DEFAULT),
         t0,
-    )
-    .map(Some)
+    )?;
+    r.collapse = collapse;
+    r.collapse_tables = collapse_tables;
+    r.seconds = t0.elapsed().as_secs_f64();
+    Ok(Some(r))
+}
+
+/// State `index`'s collapse component (`collapse_reliability`) for [`state_form_with`]: none
+/// without the check, its tables, or a table of this state.
+fn collapse_component<'b>(
+    model: &'b Option<super::collapse_reliability::CapCollapseModel<'_>>,
+    tables: &'b Option<super::collapse_reliability::CapCollapseTables>,
+    index: usize,
+) -> Vec<(&'static str, Box<dyn kappe_reliability::LimitState + 'b>)> {
+    match (model, tables) {
+        (Some(m), Some(t)) => m
+            .limit_state(t, index)
+            .map(|g| ("collapse", g))
+            .into_iter()
+            .collect(),
+        _ => Vec::new(),
+    }
 }
 
 /// One component of the print: state index, check name, FORM result and SORM.
@@ -2183,5 +2265,7 @@ pub fn print_reliability(
         seconds: t0.elapsed().as_secs_f64(),
         monte_carlo: None,
         sorm,
+        collapse: None,
+        collapse_tables: None,
     })
 }

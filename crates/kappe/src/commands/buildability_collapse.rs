@@ -95,40 +95,22 @@ use serde::{Deserialize, Serialize};
 use kappe_reliability::{EvalError, Fallible, FormResult, LimitState};
 
 use crate::analysis::collapse::{Collapse, CollapseMode};
-use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
+use crate::analysis::collapse_reliability::{
+    LogAxis, admit, coefficients, grid_point, grid_size, interpolate, least_log,
+};
+use crate::analysis::design_monte_carlo::bits;
 use crate::commands::buildability::{BuildState, Resolved, check_layers};
 use crate::commands::buildability_reliability::{
-    E0, F0, FRATE, GAMMA, PARAMETERS, Prepared, RATE, T, Z_RANGE, resolved_at, t_hours,
-    table_coefficients, uerr, variable_box,
+    E0, F0, FRATE, GAMMA, PARAMETERS, Prepared, RATE, T, Z_RANGE, resolved_at, t_hours, uerr,
+    variable_box,
 };
 use crate::input::error::DesignError;
 
 pub use crate::input::uncertainty::IMPERFECTION;
 
-/// Chebyshev points per axis of a collapse table. λ_c is smooth in each parameter away from a
-/// kink (see the module docs); 5 points per axis (25 paths per state with two axes) keep a
-/// table at ~25 paths per state. Their error is measured at every design point, not assumed.
-pub const COLLAPSE_NODES: usize = 5;
-
-/// Most uncertain parameters a collapse table spans (5² = 25 paths per state; three would be
-/// 125).
-pub const MAX_AXES: usize = 2;
-
-/// The margin on the measured spans of the state rule (module docs).
-pub const SPAN_SAFETY: f64 = 1.5;
-
-/// Half-width of the state rule's box, in standard deviations: a state that cannot fail inside
-/// it has P_f ≤ P(some |zᵢ| > 4) ≈ d·6.3·10⁻⁵ (d ≤ 2 axes, and γ), negligible against any print
-/// P_f the β target admits (Φ(−2.3) ≈ 10⁻²).
-pub const Z_SELECT: f64 = 4.0;
-
-/// Points per axis on which the state rule evaluates a table's interpolant.
-const SELECT_POINTS: usize = 9;
-
-/// The table's error at a design point, as Δβ = |ln λ_table − ln λ_path|/‖∇ᵤg‖, that the tests
-/// accept: below FORM's own first-order error measured on these objects (Δβ ≈ 0.07 on study
-/// No. 14's last state, docs/reliability.md), so the table adds no error FORM does not have.
-pub const DESIGN_POINT_BETA_TOLERANCE: f64 = 0.05;
+pub use crate::analysis::collapse_reliability::{
+    COLLAPSE_NODES, DESIGN_POINT_BETA_TOLERANCE, MAX_AXES, SPAN_SAFETY, Z_SELECT,
+};
 
 /// The nominal value of `analysis.nonlinear.imperfection` in `r` and that it is positive, or why
 /// it cannot be uncertain (module docs).
@@ -136,22 +118,7 @@ pub const DESIGN_POINT_BETA_TOLERANCE: f64 = 0.05;
 /// # Errors
 /// No collapse check, or `imperfection = 0`.
 pub fn imperfection_nominal(r: &Resolved) -> Result<(f64, bool), String> {
-    match r.spec.nonlinear() {
-        None => Err(
-            "the imperfection amplitude is an input of the nonlinear collapse check \
-             only: give [analysis.nonlinear] (enabled) or remove it"
-                .to_owned(),
-        ),
-        Some(nl) => match nl.imperfection {
-            Some(w) if w <= 0.0 => Err(format!(
-                "[analysis.nonlinear] imperfection = {w} is the perfect path, which has no \
-                 scatter to model; give w0 > 0 m, or leave it to the rule, whose w0 the \
-                 variable then multiplies (mean 1)"
-            )),
-            Some(w) => Ok((w, true)),
-            None => Ok((1.0, true)),
-        },
-    }
+    crate::input::uncertainty::imperfection_nominal(r.spec.nonlinear())
 }
 
 /// The uncertain parameters λ_c depends on (module docs): (index in [`PARAMETERS`] or None for
@@ -240,18 +207,11 @@ pub fn direct(r: &Resolved, n: usize, p: &[f64; 6], m: f64) -> Result<Collapse, 
     })
 }
 
-/// One axis of the tables: ln of its variable over the box. Numbers travel as their bit
-/// patterns when shipped (`SurrogateTables`).
+/// One axis of the tables: the parameter, its model index and its grid in the logarithm.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct Axis {
     param: Option<usize>,
     var: usize,
-    #[serde(with = "bits")]
-    nodes: Vec<f64>,
-    #[serde(with = "bits")]
-    weights: Vec<f64>,
-    #[serde(with = "bits::pair")]
-    range: [f64; 2],
 }
 
 /// One layer count's table: ln λ_c at γ₀ on the grid (the first axis slowest).
@@ -270,6 +230,7 @@ struct StateTable {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct CollapseTables {
     axes: Vec<Axis>,
+    grid: Vec<LogAxis>,
     states: Vec<StateTable>,
     /// Layer counts whose nominal λ_c is 0 (mechanisms): they fail in every sample.
     mechanisms: Vec<usize>,
@@ -288,17 +249,6 @@ pub struct CollapseTables {
     pub seconds: f64,
 }
 
-/// The grid indices of flat index `flat` (the last axis fastest).
-fn grid_index(axes: &[Axis], mut flat: usize) -> Vec<usize> {
-    let mut out = vec![0; axes.len()];
-    for (o, a) in out.iter_mut().zip(axes).rev() {
-        let k = a.nodes.len().max(1);
-        *o = flat % k;
-        flat /= k;
-    }
-    out
-}
-
 impl CollapseTables {
     /// The tables of the layer counts the state rule keeps (module docs), from the
     /// deterministic run's `states` (their collapse factors).
@@ -313,25 +263,16 @@ impl CollapseTables {
     ) -> Result<CollapseTables, DesignError> {
         let t0 = kappe_fe::clock::Instant::now();
         let boxes = variable_box(r, p)?;
-        let axes = axes_of(r, p)
+        let axes: Vec<Axis> = axes_of(r, p)
             .into_iter()
-            .map(|(param, var)| {
-                let [lo, hi] = boxes.get(var).copied().unwrap_or([f64::NAN; 2]);
-                if !(lo > 0.0 && hi > lo && hi.is_finite()) {
-                    return Err(uerr(
-                        format!("uncertainty.\"{}\"", axis_name(param)),
-                        format!("the collapse table needs a positive range, got [{lo}, {hi}]"),
-                    ));
-                }
-                let range = [lo.ln(), hi.ln()];
-                let (nodes, weights) = cheb(range[0], range[1], COLLAPSE_NODES);
-                Ok(Axis {
-                    param,
-                    var,
-                    nodes,
-                    weights,
-                    range,
-                })
+            .map(|(param, var)| Axis { param, var })
+            .collect();
+        let grid = axes
+            .iter()
+            .map(|a| {
+                let [lo, hi] = boxes.get(a.var).copied().unwrap_or([f64::NAN; 2]);
+                LogAxis::new(lo, hi)
+                    .map_err(|m| uerr(format!("uncertainty.\"{}\"", axis_name(a.param)), m))
             })
             .collect::<Result<Vec<_>, DesignError>>()?;
         let gamma0 = p.nominal[GAMMA];
@@ -355,6 +296,7 @@ impl CollapseTables {
         order.sort_by(|a, b| a.1.total_cmp(&b.1));
         let mut out = CollapseTables {
             axes,
+            grid,
             states: Vec::new(),
             mechanisms,
             gamma0,
@@ -380,25 +322,36 @@ impl CollapseTables {
                 .collect();
             out.span = gamma_select;
         } else {
-            let mut next: Vec<usize> = order.first().map(|s| s.0).into_iter().collect();
-            while !next.is_empty() {
-                let new = out.tabulate(r, p, &next)?;
-                for t in new {
-                    let g = order
-                        .iter()
-                        .find(|s| s.0 == t.layers)
-                        .map_or(f64::NAN, |s| s.1);
-                    let least = out.least_log(&t) - collapse_min.ln() - gamma_select;
-                    out.span = out.span.max(g - least);
-                    out.states.push(t);
-                }
-                let bound = SPAN_SAFETY * out.span;
-                next = order
-                    .iter()
-                    .filter(|&&(n, g)| g <= bound && !out.has_table(n))
-                    .map(|s| s.0)
-                    .collect();
-            }
+            // The selection box: ±Z_SELECT of the ±Z_RANGE box in each axis' logarithm
+            // (exact for a lognormal without drift, whose logarithm is linear in z).
+            let select: Vec<[f64; 2]> = out
+                .grid
+                .iter()
+                .map(|a| {
+                    let [lo, hi] = a.range();
+                    let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo) * Z_SELECT / Z_RANGE);
+                    [mid - half, mid + half]
+                })
+                .collect();
+            let this = &out;
+            let mut solves = 0;
+            // γ's exact shift is taken into the spans (and so times SPAN_SAFETY), as this
+            // rule was first written and measured (the cap's rule keeps it apart).
+            let (tables, span) = admit(
+                &order,
+                0.0,
+                |next| {
+                    let t = this.tabulate(r, p, next)?;
+                    solves += t.len() * grid_size(&this.grid);
+                    Ok::<_, DesignError>(t.into_iter().map(|t| (t.layers, t)).collect())
+                },
+                |t: &StateTable| {
+                    least_log(&this.grid, &t.log, &select) - collapse_min.ln() - gamma_select
+                },
+            )?;
+            out.solves += solves;
+            out.span = span;
+            out.states = tables.into_iter().map(|t| t.1).collect();
         }
         out.states.sort_by_key(|s| s.layers);
         out.seconds = t0.elapsed().as_secs_f64();
@@ -407,25 +360,25 @@ impl CollapseTables {
 
     /// The grids of the layer counts `layers`, every (state, point) path in parallel.
     fn tabulate(
-        &mut self,
+        &self,
         r: &Resolved,
         p: &Prepared,
         layers: &[usize],
     ) -> Result<Vec<StateTable>, DesignError> {
-        let total: usize = self.axes.iter().map(|a| a.nodes.len()).product();
+        let total = grid_size(&self.grid);
         let m0 = imperfection_nominal(r).map_or(1.0, |v| v.0);
         let jobs: Vec<(usize, usize)> = layers
             .iter()
             .flat_map(|&n| (0..total).map(move |j| (n, j)))
             .collect();
-        let axes = &self.axes;
+        let (axes, grid) = (&self.axes, &self.grid);
         let solved = jobs
             .par_iter()
             .map(|&(n, j)| {
                 let mut params = p.nominal;
                 let mut m = m0;
-                for (a, i) in axes.iter().zip(grid_index(axes, j)) {
-                    let v = a.nodes.get(i).copied().unwrap_or(f64::NAN).exp();
+                let point = grid_point(grid, j);
+                for (a, &v) in axes.iter().zip(&point) {
                     match a.param {
                         Some(k) => params[k] = v,
                         None => m = v,
@@ -441,12 +394,8 @@ impl CollapseTables {
                              mechanism; narrow the scatter",
                             c.factor,
                             axes.iter()
-                                .zip(grid_index(axes, j))
-                                .map(|(a, i)| format!(
-                                    "{} = {:.4e}",
-                                    axis_name(a.param),
-                                    a.nodes.get(i).copied().unwrap_or(f64::NAN).exp()
-                                ))
+                                .zip(&point)
+                                .map(|(a, v)| format!("{} = {v:.4e}", axis_name(a.param)))
                                 .collect::<Vec<_>>()
                                 .join(", ")
                         ),
@@ -455,7 +404,6 @@ impl CollapseTables {
                 Ok((c.factor.ln(), c.mode))
             })
             .collect::<Result<Vec<_>, DesignError>>()?;
-        self.solves += solved.len();
         Ok(layers
             .iter()
             .zip(solved.chunks(total.max(1)))
@@ -465,49 +413,6 @@ impl CollapseTables {
                 modes: c.iter().map(|v| v.1).collect(),
             })
             .collect())
-    }
-
-    /// The least ln λ_c (at γ₀) of table `t` over the selection box: ±[`Z_SELECT`] of the
-    /// ±[`Z_RANGE`] box in each axis' logarithm (exact for a lognormal without drift, whose
-    /// logarithm is linear in z), on [`SELECT_POINTS`] points per axis of the interpolant
-    /// (nodes and edges included).
-    fn least_log(&self, t: &StateTable) -> f64 {
-        let k = SELECT_POINTS;
-        let total = k.pow(self.axes.len() as u32);
-        (0..total)
-            .map(|j| {
-                let mut rest = j;
-                let mut coefs = Vec::with_capacity(self.axes.len());
-                for a in self.axes.iter().rev() {
-                    let i = rest % k;
-                    rest /= k;
-                    let [lo, hi] = a.range;
-                    let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo) * Z_SELECT / Z_RANGE);
-                    let s = mid - half + 2.0 * half * i as f64 / (k - 1) as f64;
-                    let mut c = vec![0.0; a.nodes.len()];
-                    bary_into(&a.nodes, &a.weights, s, &mut c);
-                    coefs.push(c);
-                }
-                coefs.reverse();
-                self.interpolate(t, &coefs)
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// The table's interpolant from per-axis barycentric coefficients.
-    fn interpolate(&self, t: &StateTable, coefs: &[Vec<f64>]) -> f64 {
-        t.log
-            .iter()
-            .enumerate()
-            .map(|(j, v)| {
-                let w: f64 = grid_index(&self.axes, j)
-                    .iter()
-                    .zip(coefs)
-                    .map(|(&i, c)| c.get(i).copied().unwrap_or(0.0))
-                    .product();
-                w * v
-            })
-            .sum()
     }
 
     fn has_table(&self, n: usize) -> bool {
@@ -566,17 +471,16 @@ impl CollapseTables {
         let Some(t) = self.states.iter().find(|s| s.layers == n) else {
             return Ok(None);
         };
-        let mut coefs = Vec::with_capacity(self.axes.len());
-        for a in &self.axes {
-            let s = x.get(a.var).copied().unwrap_or(f64::NAN).ln();
-            let mut c = vec![0.0; a.nodes.len()];
-            if !table_coefficients(&a.nodes, &a.weights, a.range, s, clamp, &mut c) {
-                fallbacks.fetch_add(1, Ordering::Relaxed);
-                return Self::direct_at(r, p, n, x).map(|c| Some(c.factor));
-            }
-            coefs.push(c);
-        }
-        let log = self.interpolate(t, &coefs);
+        let s: Vec<f64> = self
+            .axes
+            .iter()
+            .map(|a| x.get(a.var).copied().unwrap_or(f64::NAN).ln())
+            .collect();
+        let Some(coefs) = coefficients(&self.grid, &s, clamp) else {
+            fallbacks.fetch_add(1, Ordering::Relaxed);
+            return Self::direct_at(r, p, n, x).map(|c| Some(c.factor));
+        };
+        let log = interpolate(&self.grid, &t.log, &coefs);
         let gamma = p.params(x)[GAMMA];
         Ok(Some(log.exp() * self.gamma0 / gamma))
     }

@@ -43,7 +43,7 @@ use kappe_reliability::{
     merge_events, sample_events,
 };
 
-use crate::analysis::design_monte_carlo::{bary_into, bits, cheb};
+use crate::analysis::design_monte_carlo::{bits, cheb, table_coefficients};
 use crate::analysis::green::{BucklingOutcome, ModeStart, bed_traction, principal, solve_state};
 use crate::analysis::reliability::{Reliability, form_checks, print_reliability};
 use crate::commands::buildability::{Resolved, check_layers, object_shell};
@@ -484,59 +484,6 @@ pub(crate) fn t_hours(r: &Resolved, n: usize) -> f64 {
         .get(n.saturating_sub(1))
         .map_or(0.0, |l| l.end_s)
         / 3600.0
-}
-
-/// The barycentric coefficients at s outside the range [lo, hi] of `nodes`, for FORM only:
-/// the tables (all logarithms) continued as straight lines in s from the nearer edge (C¹;
-/// power laws in the variable), so that FORM's far iterates see a smooth surface. `out` is as
-/// long as `nodes` (at most [`NODES`]).
-pub(crate) fn bary_continued(
-    nodes: &[f64],
-    weights: &[f64],
-    [lo, hi]: [f64; 2],
-    s: f64,
-    out: &mut [f64],
-) {
-    let k = nodes.len().min(NODES);
-    let (e, inner) = if s < lo {
-        (lo, lo + 1e-3 * (hi - lo))
-    } else {
-        (hi, hi - 1e-3 * (hi - lo))
-    };
-    let mut ce = [0.0; NODES];
-    let mut ci = [0.0; NODES];
-    bary_into(nodes, weights, e, &mut ce[..k]);
-    bary_into(nodes, weights, inner, &mut ci[..k]);
-    let t = (s - e) / (e - inner);
-    for (j, c) in out.iter_mut().enumerate().take(k) {
-        *c = ce[j] + (ce[j] - ci[j]) * t;
-    }
-}
-
-/// The barycentric coefficients of a table axis over `[lo, hi]` at s, into `out`: inside the
-/// range the interpolant's; outside it, with `clamp` (FORM), the straight continuation of
-/// [`bary_continued`], s held at 10³ box widths beyond the edge (FORM's far iterates, where
-/// x → 0 or ∞ underflows the logarithm, stay finite so FORM reports a far β instead of failing
-/// on an evaluation). `false` when s is outside without `clamp` (or NaN): the caller falls back
-/// to a direct solve and counts it.
-pub(crate) fn table_coefficients(
-    nodes: &[f64],
-    weights: &[f64],
-    [lo, hi]: [f64; 2],
-    s: f64,
-    clamp: bool,
-    out: &mut [f64],
-) -> bool {
-    if (lo..=hi).contains(&s) {
-        bary_into(nodes, weights, s, out);
-        true
-    } else if clamp && !s.is_nan() {
-        let far = 1e3 * (hi - lo);
-        bary_continued(nodes, weights, [lo, hi], s.clamp(lo - far, hi + far), out);
-        true
-    } else {
-        false
-    }
 }
 
 /// Per model variable, the range [lo, hi] of ±[`Z_RANGE`] standard deviations over every

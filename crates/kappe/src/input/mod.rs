@@ -23,4 +23,4 @@ pub use analysis::AnalysisOptions;
 pub use design::EXAMPLE_TOML;
 pub use material::{TimeLaw, TimeModel, TimeModelSpec};
 pub use nonlinear::{NonlinearSpec, PathStart};
-pub use uncertainty::{BETA_MIN_DEFAULT, UncertaintyTable};
+pub use uncertainty::{BETA_MIN_DEFAULT, IMPERFECTION, UncertaintyTable};

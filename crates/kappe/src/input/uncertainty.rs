@@ -21,9 +21,37 @@
 
 use std::collections::BTreeMap;
 
-/// The name of the imperfection amplitude in `[uncertainty]`: an input of buildability specs
-/// with `[analysis.nonlinear]` (`commands::buildability_collapse`), refused in a design.
+/// The name of the imperfection amplitude in `[uncertainty]`: an input of designs and
+/// buildability specs with `[analysis.nonlinear]` (`crate::analysis::collapse_reliability`,
+/// `commands::buildability_collapse`), refused without it.
 pub const IMPERFECTION: &str = "analysis.nonlinear.imperfection";
+
+/// The nominal value of [`IMPERFECTION`] under `nonlinear` and that it is positive: w0 (m)
+/// when `imperfection = w0` is given, else 1 (a factor on the rule's w0); or why it cannot be
+/// uncertain. The one rule of designs and buildability specs.
+///
+/// # Errors
+/// No enabled collapse check, or `imperfection = 0` (the perfect path: nothing to scatter).
+pub fn imperfection_nominal(
+    nonlinear: Option<&crate::input::nonlinear::NonlinearSpec>,
+) -> Result<(f64, bool), String> {
+    match nonlinear.filter(|n| n.enabled) {
+        None => Err(
+            "the imperfection amplitude is an input of the nonlinear collapse check \
+             only: give [analysis.nonlinear] (enabled) or remove it"
+                .to_owned(),
+        ),
+        Some(nl) => match nl.imperfection {
+            Some(w) if w <= 0.0 => Err(format!(
+                "[analysis.nonlinear] imperfection = {w} is the perfect path, which has no \
+                 scatter to model; give w0 > 0 m, or leave it to the rule, whose w0 the \
+                 variable then multiplies (mean 1)"
+            )),
+            Some(w) => Ok((w, true)),
+            None => Ok((1.0, true)),
+        },
+    }
+}
 
 use kappe_reliability::{Correlation, Drift, Model, UncertaintySpec};
 use serde::{Deserialize, Serialize};
@@ -272,14 +300,10 @@ impl UncertaintyTable {
                 );
             }
             if name == IMPERFECTION {
-                // Accepted by buildability specs (commands::buildability_collapse); a design's
-                // collapse is not yet a limit state of its reliability (docs/reliability.md).
-                return Err(
-                    "the imperfection amplitude is an uncertain input of buildability specs \
-                     with [analysis.nonlinear] (kappe buildability); a design's collapse is \
-                     not yet a limit state of its reliability"
-                        .to_owned(),
-                );
+                // The collapse limit state of the design's states
+                // (`crate::analysis::collapse_reliability`): w0 in m when `imperfection` is
+                // given, else a factor (mean 1) on every state's rule w0; positive only.
+                return imperfection_nominal(design.analysis.nonlinear.as_ref());
             }
             if STRENGTH_PARAMETERS.contains(&name) {
                 let time = design.time_model().map_err(|e| e.to_string())?;

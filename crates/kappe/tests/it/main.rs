@@ -10,6 +10,7 @@ mod buildability_reliability;
 mod cap;
 mod ceiling;
 mod collapse;
+mod collapse_reliability;
 mod common;
 mod corrugation;
 mod design_monte_carlo;

@@ -51,11 +51,11 @@ fn bad_uncertainty_is_a_named_error() {
             "uncertainty.correlation",
         ),
         (
-            // A design's collapse is not a limit state yet: the name is refused with the
-            // reason and where it is accepted, not as an unknown name.
-            "[analysis.nonlinear]\nimperfection = 0.002\n[uncertainty]\n\
+            // The imperfection is an input of the collapse check only: without
+            // [analysis.nonlinear] it is refused with the reason, not as an unknown name.
+            "[uncertainty]\n\
              \"analysis.nonlinear.imperfection\" = { dist = \"lognormal\", cov = 0.5 }\n",
-            "kappe buildability",
+            "[analysis.nonlinear]",
         ),
     ];
     for (text, needle) in cases {
