@@ -320,7 +320,14 @@ impl LocalGeometric {
             for j in 0..3 {
                 h += gd[j] * (2.0 * self.dq[(kk, j)]);
             }
-            k += gd[kk] * h.transpose() + ck * gd[kk].transpose();
+            // k += g hᵀ + c gᵀ entry by entry: the same sums as the matrix expression
+            // (each entry `k + (g_i h_j + c_i g_j)`), without its three 18×18 temporaries.
+            let g = &gd[kk];
+            for j in 0..18 {
+                for i in 0..18 {
+                    k[(i, j)] += g[i] * h[j] + ck[i] * g[j];
+                }
+            }
         }
         (f, k)
     }

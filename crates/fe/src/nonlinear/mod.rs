@@ -54,7 +54,7 @@ pub use path::{
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 
-use crate::assembly::{DofMap, Pattern, geometries, load_vector, scatter};
+use crate::assembly::{DofMap, Pattern, geometries, load_vector, scatter, scatter_with};
 use crate::element::ShellElement;
 use crate::error::FeError;
 use crate::model::ShellModel;
@@ -147,6 +147,8 @@ pub(crate) struct Problem<'m> {
     pub(crate) dofs: DofMap,
     pub(crate) pattern: Pattern,
     pub(crate) symbolic: crate::factor::Symbolic,
+    /// The path's factorizations recycle their value arrays and workspace here.
+    pub(crate) buffers: crate::factor::FactorBuffers,
     elements: Vec<CrElement>,
     /// Reference load on the free DOFs.
     pub(crate) q: Vec<f64>,
@@ -231,6 +233,7 @@ impl<'m> Problem<'m> {
             dofs,
             pattern,
             symbolic,
+            buffers: Default::default(),
             elements: co_rotational_elements(model, local_geometric),
             q,
             weight,
@@ -261,13 +264,18 @@ impl<'m> Problem<'m> {
         let skew = self.has_moments;
         const CHUNK: usize = 2048;
         let n_el = model.triangles.len();
+        // One buffer for every chunk (rayon's `collect_into_vec` reuses it), read in place:
+        // an element's 18×18 tangent is 2.6 kB, and moving it out again per element cost as
+        // much as a good part of its computation.
+        let mut out: Vec<(Vec18, Option<crate::element::Mat18>)> =
+            Vec::with_capacity(CHUNK.min(n_el));
         let mut start = 0;
         while start < n_el {
             let end = (start + CHUNK).min(n_el);
-            // Each element's tangent is collected as it is and split into its symmetric and
-            // skew parts while scattering: one 18×18 matrix per element through the collect
-            // instead of two halves the memory it moves.
-            let out: Vec<(Vec18, Option<crate::element::Mat18>)> = (start..end)
+            // Each element's tangent is collected as it is; its symmetric and skew parts
+            // are formed entry by entry while scattering (`scatter_with`), only where they
+            // are scattered.
+            (start..end)
                 .into_par_iter()
                 .map(|e| {
                     let t = &model.triangles[e];
@@ -275,8 +283,8 @@ impl<'m> Problem<'m> {
                     let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
                     self.elements[e].force_tangent(&x, &r, tangent)
                 })
-                .collect();
-            for (e, (f, k)) in (start..end).zip(out) {
+                .collect_into_vec(&mut out);
+            for (e, (f, k)) in (start..end).zip(&out) {
                 let t = &model.triangles[e];
                 for (a, &n) in t.iter().enumerate() {
                     for d in 0..6 {
@@ -284,22 +292,21 @@ impl<'m> Problem<'m> {
                     }
                 }
                 if let (Some(k), Some(tg)) = (k, kv.as_mut()) {
-                    let kt = k.transpose();
-                    scatter(
+                    scatter_with(
                         model,
                         &self.dofs,
                         &self.pattern,
                         e,
-                        &((k + kt) * 0.5),
+                        |p, q| (k[(p, q)] + k[(q, p)]) * 0.5,
                         &mut tg.sym,
                     )?;
                     if skew {
-                        scatter(
+                        scatter_with(
                             model,
                             &self.dofs,
                             &self.pattern,
                             e,
-                            &((k - kt) * 0.5),
+                            |p, q| (k[(p, q)] - k[(q, p)]) * 0.5,
                             &mut tg.skew,
                         )?;
                     }
