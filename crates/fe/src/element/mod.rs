@@ -80,6 +80,18 @@ pub trait ShellElement: Send + Sync {
     fn stiffness(&self, g: &TriangleGeometry, t: f64, m: &Material, drilling_alpha: f64) -> Mat18;
     /// Resultants from the element's 18 global displacements.
     fn resultants(&self, g: &TriangleGeometry, t: f64, m: &Material, u: &[f64; 18]) -> Resultants;
+    /// The membrane forces of [`Self::resultants`] alone, the same numbers: an element
+    /// whose membrane part stands apart computes them without the plate's moments (the
+    /// co-rotational facets take 18 of them each, nonlinear::corotational::LocalGeometric).
+    fn membrane_resultants(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        u: &[f64; 18],
+    ) -> [f64; 3] {
+        self.resultants(g, t, m, u).membrane
+    }
     /// Global geometric stiffness for constant membrane forces `n = [N_x, N_y, N_xy]`
     /// (tension positive), so that `(K + λ K_G) φ = 0` is the buckling pencil. Thickness and
     /// material are passed because a shear-deformable plate's deflection slopes depend on

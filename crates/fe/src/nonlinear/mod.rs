@@ -186,7 +186,7 @@ fn co_rotational_elements(model: &ShellModel, local: bool) -> Vec<CrElement> {
                     geo[e].area,
                     dm,
                     |n| el.geometric_stiffness(&geo[e], t, &mat, n),
-                    |u| el.resultants(&geo[e], t, &mat, u).membrane,
+                    |u| el.membrane_resultants(&geo[e], t, &mat, u),
                 )
             });
             CrElement::new(&geo[e], &k, lg)
