@@ -176,6 +176,19 @@ pub(crate) fn scatter(
     ke: &Mat18,
     vals: &mut [f64],
 ) -> Result<(), FeError> {
+    scatter_with(model, dofs, pattern, e, |p, q| ke[(p, q)], vals)
+}
+
+/// As [`scatter`], with entry `(p, q)` of the element matrix given by `ke(p, q)`: only the
+/// entries scattered are computed (e.g. a symmetric part `½(K_pq + K_qp)` without forming it).
+pub(crate) fn scatter_with(
+    model: &ShellModel,
+    dofs: &DofMap,
+    pattern: &Pattern,
+    e: usize,
+    ke: impl Fn(usize, usize) -> f64,
+    vals: &mut [f64],
+) -> Result<(), FeError> {
     let gd = element_dofs(&model.triangles[e]);
     let fd: [usize; 18] = std::array::from_fn(|k| dofs.map[gd[k]]);
     for q in 0..18 {
@@ -204,7 +217,7 @@ pub(crate) fn scatter(
                         detail: format!("entry ({i}, {j}) missing from the sparsity pattern"),
                     });
                 }
-                vals[at] += ke[(p, q)];
+                vals[at] += ke(p, q);
                 pos = Some(at);
             }
         }

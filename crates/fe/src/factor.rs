@@ -2,7 +2,9 @@
 //! (AMD ordering, supernodal or simplicial by flop count), then numeric LLᵀ of K and LDLᵀ of
 //! `K + σ K_G` for the Sturm count. The symbolic part is what [`crate::BucklingSolver`] caches.
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use std::sync::Mutex;
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::cholesky::{
     LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
     factorize_symbolic_cholesky,
@@ -130,7 +132,7 @@ impl Symbolic {
         p: &Pattern,
         vals: &[f64],
     ) -> Result<Option<usize>, FeError> {
-        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (Sturm check)")? else {
+        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (Sturm check)", None)? else {
             return Ok(None);
         };
         Ok(self.count_negative(&l))
@@ -138,25 +140,39 @@ impl Symbolic {
 
     /// The numeric LDLᵀ values (no pivoting) of the matrix with lower values `vals`; `None` when
     /// faer rejects the factorization (a zero pivot). `stage` names the caller in an
-    /// out-of-memory error.
+    /// out-of-memory error. With `buffers`, the value array and the workspace come from (and
+    /// the workspace returns to) there instead of fresh allocations.
     fn numeric_ldlt(
         &self,
         p: &Pattern,
         vals: &[f64],
         stage: &'static str,
+        buffers: Option<&FactorBuffers>,
     ) -> Result<Option<Vec<f64>>, FeError> {
         let oom = |what: &str| FeError::Numerical {
             stage,
             detail: format!("out of memory for the {what}"),
         };
-        let mut l = Vec::new();
-        l.try_reserve_exact(self.chol.len_val())
-            .map_err(|_| oom("factor"))?;
-        l.resize(self.chol.len_val(), 0.0);
+        let len = self.chol.len_val();
+        // faer sets every value of L itself (`L_values.fill(0)` before the supernodal and
+        // simplicial factorizations), so a recycled array needs no clearing and gives the
+        // same factor bit for bit.
+        let mut l = match buffers.and_then(|b| b.take_values(len)) {
+            Some(l) => l,
+            None => {
+                let mut l = Vec::new();
+                l.try_reserve_exact(len).map_err(|_| oom("factor"))?;
+                l.resize(len, 0.0);
+                l
+            }
+        };
         let req = self
             .chol
             .factorize_numeric_ldlt_scratch::<f64>(par(), Default::default());
-        let mut buf = MemBuffer::try_new(req).map_err(|_| oom("workspace"))?;
+        let mut buf = match buffers.and_then(|b| b.take_scratch(req)) {
+            Some(b) => b,
+            None => MemBuffer::try_new(req).map_err(|_| oom("workspace"))?,
+        };
         let res = self.chol.factorize_numeric_ldlt::<f64>(
             &mut l,
             Self::mat(p, vals),
@@ -166,7 +182,18 @@ impl Symbolic {
             MemStack::new(&mut buf),
             Default::default(),
         );
-        Ok(res.is_ok().then_some(l))
+        if let Some(b) = buffers {
+            b.put_scratch(req, buf);
+        }
+        match res {
+            Ok(_) => Ok(Some(l)),
+            Err(_) => {
+                if let Some(b) = buffers {
+                    b.put_values(l);
+                }
+                Ok(None)
+            }
+        }
     }
 
     /// Negative diagonal entries of D in the LDLᵀ values `l` (`None` on a zero or non-finite
@@ -215,14 +242,83 @@ impl Symbolic {
     /// Numeric LDLᵀ (no pivoting) of a symmetric, possibly indefinite matrix with lower values
     /// `vals`, kept for solves; `None` on a zero or non-finite pivot (a singular tangent).
     pub(crate) fn ldlt(&self, p: &Pattern, vals: &[f64]) -> Result<Option<Ldlt<'_>>, FeError> {
-        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (tangent)")? else {
+        self.ldlt_with(p, vals, None)
+    }
+
+    /// As [`Symbolic::ldlt`], with the value array and workspace taken from `buffers`; the
+    /// factor gives its values back there when dropped. For a sequence of factorizations on
+    /// one pattern (a nonlinear path: 5·10⁶ values of L, 40 MB, and a ~20 MB workspace on the
+    /// default cap): each fresh allocation of that size is a new mapping from the system,
+    /// whose first touch page-faults and clears every page again.
+    pub(crate) fn ldlt_with<'a>(
+        &'a self,
+        p: &Pattern,
+        vals: &[f64],
+        buffers: Option<&'a FactorBuffers>,
+    ) -> Result<Option<Ldlt<'a>>, FeError> {
+        let Some(l) = self.numeric_ldlt(p, vals, "LDLᵀ (tangent)", buffers)? else {
             return Ok(None);
         };
-        Ok(self.count_negative(&l).map(|negative| Ldlt {
-            sym: self,
-            l,
-            negative,
-        }))
+        match self.count_negative(&l) {
+            Some(negative) => Ok(Some(Ldlt {
+                sym: self,
+                l,
+                negative,
+                buffers,
+            })),
+            None => {
+                if let Some(b) = buffers {
+                    b.put_values(l);
+                }
+                Ok(None)
+            }
+        }
+    }
+}
+
+/// Value arrays of dropped LDLᵀ factors and the factorization workspace, kept for the next
+/// factorization on the same symbolic structure ([`Symbolic::ldlt_with`]). Holds at most
+/// [`FactorBuffers::SPARE`] arrays: never more than were alive at once before, so the peak
+/// memory does not grow, only its release waits for the owner (the path) to end.
+#[derive(Default)]
+pub(crate) struct FactorBuffers {
+    values: Mutex<Vec<Vec<f64>>>,
+    /// The workspace with the request it was allocated for.
+    scratch: Mutex<Option<(StackReq, MemBuffer)>>,
+}
+
+impl FactorBuffers {
+    /// Spare value arrays kept (a path holds at most three factors at once: the step's
+    /// start, an iteration's own, and a converged point's under test).
+    const SPARE: usize = 3;
+
+    fn take_values(&self, len: usize) -> Option<Vec<f64>> {
+        let mut v = self.values.lock().unwrap_or_else(|e| e.into_inner());
+        let i = v.iter().position(|l| l.len() == len)?;
+        Some(v.swap_remove(i))
+    }
+
+    fn put_values(&self, l: Vec<f64>) {
+        let mut v = self.values.lock().unwrap_or_else(|e| e.into_inner());
+        if v.len() < Self::SPARE {
+            v.push(l);
+        }
+    }
+
+    fn take_scratch(&self, req: StackReq) -> Option<MemBuffer> {
+        let mut s = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        // Only for the request it was allocated for (one symbolic structure: always).
+        match s.take() {
+            Some((r, b)) if r == req => Some(b),
+            other => {
+                *s = other;
+                None
+            }
+        }
+    }
+
+    fn put_scratch(&self, req: StackReq, b: MemBuffer) {
+        *self.scratch.lock().unwrap_or_else(|e| e.into_inner()) = Some((req, b));
     }
 }
 
@@ -232,6 +328,16 @@ pub(crate) struct Ldlt<'a> {
     l: Vec<f64>,
     /// Number of negative pivots = negative eigenvalues (Sylvester).
     pub(crate) negative: usize,
+    /// Where the values go when the factor is dropped.
+    buffers: Option<&'a FactorBuffers>,
+}
+
+impl Drop for Ldlt<'_> {
+    fn drop(&mut self) {
+        if let Some(b) = self.buffers {
+            b.put_values(std::mem::take(&mut self.l));
+        }
+    }
 }
 
 impl Ldlt<'_> {

@@ -241,6 +241,16 @@ impl ShellElement for AndesDkt {
         }
     }
 
+    fn membrane_resultants(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        u: &[f64; 18],
+    ) -> [f64; 3] {
+        Self::membrane_forces(g, t, m, &to_local(u, &g.frame))
+    }
+
     fn geometric_stiffness(
         &self,
         g: &TriangleGeometry,

@@ -347,6 +347,16 @@ impl ShellElement for AndesDkmt {
         }
     }
 
+    fn membrane_resultants(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        u: &[f64; 18],
+    ) -> [f64; 3] {
+        AndesDkt::membrane_forces(g, t, m, &to_local(u, &g.frame))
+    }
+
     fn geometric_stiffness(
         &self,
         g: &TriangleGeometry,
@@ -369,6 +379,16 @@ impl ShellElement for CstDkmt {
             membrane: CstDkt::membrane_forces(g, t, m, &ul),
             moment: dkmt_centroid_moment(g, t, m, &ul),
         }
+    }
+
+    fn membrane_resultants(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        u: &[f64; 18],
+    ) -> [f64; 3] {
+        CstDkt::membrane_forces(g, t, m, &to_local(u, &g.frame))
     }
 
     fn geometric_stiffness(

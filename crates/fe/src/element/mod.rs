@@ -80,6 +80,18 @@ pub trait ShellElement: Send + Sync {
     fn stiffness(&self, g: &TriangleGeometry, t: f64, m: &Material, drilling_alpha: f64) -> Mat18;
     /// Resultants from the element's 18 global displacements.
     fn resultants(&self, g: &TriangleGeometry, t: f64, m: &Material, u: &[f64; 18]) -> Resultants;
+    /// The membrane forces of [`Self::resultants`] alone, the same numbers: an element
+    /// whose membrane part stands apart computes them without the plate's moments (the
+    /// co-rotational facets take 18 of them each, nonlinear::corotational::LocalGeometric).
+    fn membrane_resultants(
+        &self,
+        g: &TriangleGeometry,
+        t: f64,
+        m: &Material,
+        u: &[f64; 18],
+    ) -> [f64; 3] {
+        self.resultants(g, t, m, u).membrane
+    }
     /// Global geometric stiffness for constant membrane forces `n = [N_x, N_y, N_xy]`
     /// (tension positive), so that `(K + λ K_G) φ = 0` is the buckling pencil. Thickness and
     /// material are passed because a shear-deformable plate's deflection slopes depend on
@@ -95,20 +107,26 @@ pub trait ShellElement: Send + Sync {
 
 /// Rotate a local 18×18 matrix to the global frame: `Tᵀ K T`, T = blockdiag(R ×6).
 pub(crate) fn to_global(k: &Mat18, frame: &[[f64; 3]; 3]) -> Mat18 {
+    let mut out = Mat18::zeros();
+    to_global_into(k, frame, &mut out);
+    out
+}
+
+/// [`to_global`] written into `out` (every entry; a zero block of `k` gives a zero block).
+pub(crate) fn to_global_into(k: &Mat18, frame: &[[f64; 3]; 3], out: &mut Mat18) {
     let r = nalgebra::Matrix3::from_fn(|i, j| frame[i][j]);
     let rt = r.transpose();
-    let mut out = Mat18::zeros();
     for a in 0..6 {
         for b in 0..6 {
             let blk = k.fixed_view::<3, 3>(3 * a, 3 * b).into_owned();
+            let mut dst = out.fixed_view_mut::<3, 3>(3 * a, 3 * b);
             if blk.iter().all(|v| *v == 0.0) {
+                dst.fill(0.0);
                 continue;
             }
-            out.fixed_view_mut::<3, 3>(3 * a, 3 * b)
-                .copy_from(&(rt * blk * r));
+            dst.copy_from(&(rt * blk * r));
         }
     }
-    out
 }
 
 /// Rotate global 18 displacements to local ones: `T u`.

@@ -39,7 +39,7 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
-use crate::element::{Mat18, TriangleGeometry, to_global};
+use crate::element::{Mat18, TriangleGeometry, to_global_into};
 
 /// 18-vector.
 pub(crate) type Vec18 = SVector<f64, 18>;
@@ -320,7 +320,14 @@ impl LocalGeometric {
             for j in 0..3 {
                 h += gd[j] * (2.0 * self.dq[(kk, j)]);
             }
-            k += gd[kk] * h.transpose() + ck * gd[kk].transpose();
+            // k += g hᵀ + c gᵀ entry by entry: the same sums as the matrix expression
+            // (each entry `k + (g_i h_j + c_i g_j)`), without its three 18×18 temporaries.
+            let g = &gd[kk];
+            for j in 0..18 {
+                for i in 0..18 {
+                    k[(i, j)] += g[i] * h[j] + ck[i] * g[j];
+                }
+            }
         }
         (f, k)
     }
@@ -432,13 +439,27 @@ impl CrElement {
     }
 
     /// Global internal force and (unsymmetrised, consistent) tangent.
+    #[cfg(test)]
     pub(crate) fn force_tangent(
         &self,
         x: &[Vector3<f64>; 3],
         r: &[&Matrix3<f64>; 3],
         tangent: bool,
     ) -> (Vec18, Option<Mat18>) {
-        self.force_tangent_with(x, r, tangent, None)
+        let mut k = tangent.then(Mat18::zeros);
+        let f = self.force_tangent_into(x, r, k.as_mut());
+        (f, k)
+    }
+
+    /// [`Self::force_tangent`] with the tangent, when asked for, written into `k` (every
+    /// entry): the assembly's buffer, instead of a 2.6 kB value moved out through the calls.
+    pub(crate) fn force_tangent_into(
+        &self,
+        x: &[Vector3<f64>; 3],
+        r: &[&Matrix3<f64>; 3],
+        k: Option<&mut Mat18>,
+    ) -> Vec18 {
+        self.force_tangent_with(x, r, k, None)
     }
 
     /// The initial-stress stiffness of the facet on the current geometry (at the reference
@@ -450,9 +471,9 @@ impl CrElement {
         r: &[&Matrix3<f64>; 3],
         d_lin: &Vec18,
     ) -> Mat18 {
-        self.force_tangent_with(x, r, true, Some(d_lin))
-            .1
-            .unwrap_or_else(Mat18::zeros)
+        let mut k = Mat18::zeros();
+        self.force_tangent_with(x, r, Some(&mut k), Some(d_lin));
+        k
     }
 
     /// Local deformational DOFs of a small global displacement `u` (18, element order) on
@@ -468,15 +489,16 @@ impl CrElement {
         out
     }
 
-    /// [`Self::force_tangent`]; with `stress_of = Some(d)`, the stresses are those of `d`
-    /// and the material term is left out ([`Self::initial_stress_stiffness`]).
+    /// [`Self::force_tangent_into`]; with `stress_of = Some(d)`, the stresses are those of
+    /// `d` and the material term is left out ([`Self::initial_stress_stiffness`]).
     fn force_tangent_with(
         &self,
         x: &[Vector3<f64>; 3],
         r: &[&Matrix3<f64>; 3],
-        tangent: bool,
+        out: Option<&mut Mat18>,
         stress_of: Option<&Vec18>,
-    ) -> (Vec18, Option<Mat18>) {
+    ) -> Vec18 {
+        let tangent = out.is_some();
         let k = self.kinematics(x, r);
         let (fbar, ktan) = match (stress_of, &self.local) {
             (None, None) => (self.kbar * k.d, self.kbar),
@@ -540,9 +562,9 @@ impl CrElement {
                 f[3 * blk + i] = gv[i];
             }
         }
-        if !tangent {
-            return (f, None);
-        }
+        let Some(out) = out else {
+            return f;
+        };
         // K̄ H (H mixes the rotation columns), then C = K̄ H P.
         let mut kh = ktan;
         for a in 0..3 {
@@ -582,7 +604,8 @@ impl CrElement {
         kl += g.transpose() * right_p(&fnm, &s, &g);
         let frame: [[f64; 3]; 3] =
             std::array::from_fn(|i| [k.tn[(i, 0)], k.tn[(i, 1)], k.tn[(i, 2)]]);
-        (f, Some(to_global(&kl, &frame)))
+        to_global_into(&kl, &frame, out);
+        f
     }
 }
 

@@ -51,10 +51,12 @@ pub use path::{
     nonlinear_path,
 };
 
+use std::sync::Mutex;
+
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 
-use crate::assembly::{DofMap, Pattern, geometries, load_vector, scatter};
+use crate::assembly::{DofMap, Pattern, geometries, load_vector, scatter, scatter_with};
 use crate::element::ShellElement;
 use crate::error::FeError;
 use crate::model::ShellModel;
@@ -141,12 +143,19 @@ impl Tangent {
     }
 }
 
+/// Element forces and tangents of one assembly chunk.
+type ChunkBuffers = (Vec<Vec18>, Vec<crate::element::Mat18>);
+
 /// The discretised problem: DOF numbering, pattern, symbolic factorization, elements, load.
 pub(crate) struct Problem<'m> {
     pub(crate) model: &'m ShellModel,
     pub(crate) dofs: DofMap,
     pub(crate) pattern: Pattern,
     pub(crate) symbolic: crate::factor::Symbolic,
+    /// The path's factorizations recycle their value arrays and workspace here.
+    pub(crate) buffers: crate::factor::FactorBuffers,
+    /// The assembly's per-chunk element forces and tangents, kept between evaluations.
+    chunk: Mutex<ChunkBuffers>,
     elements: Vec<CrElement>,
     /// Reference load on the free DOFs.
     pub(crate) q: Vec<f64>,
@@ -177,7 +186,7 @@ fn co_rotational_elements(model: &ShellModel, local: bool) -> Vec<CrElement> {
                     geo[e].area,
                     dm,
                     |n| el.geometric_stiffness(&geo[e], t, &mat, n),
-                    |u| el.resultants(&geo[e], t, &mat, u).membrane,
+                    |u| el.membrane_resultants(&geo[e], t, &mat, u),
                 )
             });
             CrElement::new(&geo[e], &k, lg)
@@ -231,6 +240,8 @@ impl<'m> Problem<'m> {
             dofs,
             pattern,
             symbolic,
+            buffers: Default::default(),
+            chunk: Default::default(),
             elements: co_rotational_elements(model, local_geometric),
             q,
             weight,
@@ -261,45 +272,63 @@ impl<'m> Problem<'m> {
         let skew = self.has_moments;
         const CHUNK: usize = 2048;
         let n_el = model.triangles.len();
+        // The elements write their forces and tangents into the problem's buffers (reused
+        // by every chunk and evaluation): an element's 18×18 tangent is 2.6 kB, and moving
+        // it out through the calls and a collected vector again cost a good part of its
+        // computation. Summed below in element order, as before.
+        let mut guard = self.chunk.lock().unwrap_or_else(|e| e.into_inner());
+        let (fs, ks) = &mut *guard;
+        fs.resize(CHUNK.min(n_el), Vec18::zeros());
+        if tangent {
+            ks.resize(CHUNK.min(n_el), crate::element::Mat18::zeros());
+        }
         let mut start = 0;
         while start < n_el {
             let end = (start + CHUNK).min(n_el);
-            // Each element's tangent is collected as it is and split into its symmetric and
-            // skew parts while scattering: one 18×18 matrix per element through the collect
-            // instead of two halves the memory it moves.
-            let out: Vec<(Vec18, Option<crate::element::Mat18>)> = (start..end)
-                .into_par_iter()
-                .map(|e| {
-                    let t = &model.triangles[e];
-                    let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
-                    let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
-                    self.elements[e].force_tangent(&x, &r, tangent)
-                })
-                .collect();
-            for (e, (f, k)) in (start..end).zip(out) {
+            let len = end - start;
+            let element = |i: usize, k: Option<&mut crate::element::Mat18>| {
+                let t = &model.triangles[start + i];
+                let x = [st.x[t[0]], st.x[t[1]], st.x[t[2]]];
+                let r = [&st.r[t[0]], &st.r[t[1]], &st.r[t[2]]];
+                self.elements[start + i].force_tangent_into(&x, &r, k)
+            };
+            if tangent {
+                fs[..len]
+                    .par_iter_mut()
+                    .zip(ks[..len].par_iter_mut())
+                    .enumerate()
+                    .for_each(|(i, (f, k))| *f = element(i, Some(k)));
+            } else {
+                fs[..len]
+                    .par_iter_mut()
+                    .enumerate()
+                    .for_each(|(i, f)| *f = element(i, None));
+            }
+            let ks = if tangent { &ks[..len] } else { &[] };
+            for (i, f) in fs[..len].iter().enumerate() {
+                let e = start + i;
                 let t = &model.triangles[e];
                 for (a, &n) in t.iter().enumerate() {
                     for d in 0..6 {
                         fg[6 * n + d] += f[6 * a + d];
                     }
                 }
-                if let (Some(k), Some(tg)) = (k, kv.as_mut()) {
-                    let kt = k.transpose();
-                    scatter(
+                if let (Some(k), Some(tg)) = (ks.get(i), kv.as_mut()) {
+                    scatter_with(
                         model,
                         &self.dofs,
                         &self.pattern,
                         e,
-                        &((k + kt) * 0.5),
+                        |p, q| (k[(p, q)] + k[(q, p)]) * 0.5,
                         &mut tg.sym,
                     )?;
                     if skew {
-                        scatter(
+                        scatter_with(
                             model,
                             &self.dofs,
                             &self.pattern,
                             e,
-                            &((k - kt) * 0.5),
+                            |p, q| (k[(p, q)] - k[(q, p)]) * 0.5,
                             &mut tg.skew,
                         )?;
                     }

@@ -507,7 +507,10 @@ struct Solver<'a, 'm> {
 impl<'a, 'm> Solver<'a, 'm> {
     fn factor(&mut self, kv: &Tangent) -> Result<Option<Ldlt<'a>>, FeError> {
         let t = Instant::now();
-        let f = self.p.symbolic.ldlt(&self.p.pattern, &kv.sym)?;
+        let f = self
+            .p
+            .symbolic
+            .ldlt_with(&self.p.pattern, &kv.sym, Some(&self.p.buffers))?;
         self.stats.factorizations += 1;
         self.stats.t_factor += t.elapsed().as_secs_f64();
         Ok(f)
