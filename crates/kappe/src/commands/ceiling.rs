@@ -134,6 +134,11 @@ pub struct CeilingDesign {
     pub robot: RobotSpec,
     /// Shared by every bay.
     pub analysis: AnalysisOptions,
+    /// Uncertain inputs (issue 24), keyed by the design file's names as in a cap design: every
+    /// bay's design gets the same table, so each bay reports its own reliability, and the room
+    /// its bounds ([`ceiling_summary`]). Checked per bay like a design's (unknown names, bad
+    /// distributions: named errors, with the bay).
+    pub uncertainty: Option<crate::input::uncertainty::UncertaintyTable>,
 }
 
 impl Default for CeilingDesign {
@@ -148,6 +153,7 @@ impl Default for CeilingDesign {
             constraints: d.constraints,
             robot: d.robot,
             analysis: d.analysis,
+            uncertainty: None,
         }
     }
 }
@@ -201,6 +207,7 @@ impl CeilingDesign {
                 constraints: self.constraints.clone(),
                 robot: self.robot.clone(),
                 analysis: self.analysis.clone(),
+                uncertainty: self.uncertainty.clone(),
                 ..Design::default()
             };
             d.cap.span = b.span;
@@ -580,6 +587,17 @@ impl BayOutcome {
             "closure_gap_m": (self.halves == 2).then(|| 2.0 * crate::form::ends::far_end_gap(self.design.cap.rise, self.design.tilt())),
             "worst_constraint": self.worst_constraint(),
             "min_blf": self.outcome.min_blf(),
+            // The bay's reliability under the ceiling's [uncertainty] (its summary.json has
+            // every state's): FORM's and SORM's β and P_f of the bay's print (one half: the
+            // mirrored half is the same model).
+            "reliability": self.outcome.reliability.as_ref().map(|r| json!({
+                "beta": r.beta,
+                "pf": r.pf,
+                "beta_sorm": r.sorm.as_ref().map(|s| s.beta),
+                "pf_sorm": r.sorm.as_ref().map(|s| s.pf),
+                "governing_state": r.governing_state,
+                "governing_check": r.governing_check,
+            })),
             "ok": self.outcome.verdict.ok && failures.is_empty() && !tolerance_fails,
         })
     }
@@ -597,6 +615,7 @@ pub fn ceiling_summary(design: &CeilingDesign, bays: Vec<Value>) -> Value {
     };
     let ok = bays.iter().all(|b| b["ok"].as_bool() == Some(true));
     json!({
+        "reliability": room_reliability(&bays),
         "format": "kappe.ceiling.summary",
         "version": 1,
         "name": design.name,
@@ -612,6 +631,39 @@ pub fn ceiling_summary(design: &CeilingDesign, bays: Vec<Value>) -> Value {
         "bays": bays,
         "ok": ok,
     })
+}
+
+/// The room's probability of failure from its bays' (rows of [`BayOutcome::summary`] with a
+/// `reliability`; `None` when no bay has one): the room fails when any bay's print fails, so
+/// P_room lies between the largest bay's P_f and the sum of every printed half's (Boole's
+/// bounds: they hold whatever the correlation between the bays, which share the uncertain
+/// material of one mix; the exact union would need every bay's components in one system). Per
+/// estimate: FORM's `pf` and SORM's `pf_sorm` (SORM's where every bay has one). A bay printed
+/// as two halves counts twice in the sum (two prints of the same model).
+fn room_reliability(bays: &[Value]) -> Option<Value> {
+    let rows: Vec<&Value> = bays
+        .iter()
+        .filter(|b| b["reliability"].is_object())
+        .collect();
+    if rows.is_empty() {
+        return None;
+    }
+    let bounds = |key: &str| -> Option<[f64; 2]> {
+        let mut lo = 0.0f64;
+        let mut hi = 0.0f64;
+        for b in &rows {
+            let p = b["reliability"][key].as_f64()?;
+            let halves = b["halves"].as_f64().unwrap_or(1.0);
+            lo = lo.max(p);
+            hi += halves * p;
+        }
+        Some([lo, hi.min(1.0)])
+    };
+    Some(json!({
+        "bays_with_reliability": rows.len(),
+        "pf_bounds": bounds("pf"),
+        "pf_sorm_bounds": bounds("pf_sorm"),
+    }))
 }
 
 impl CeilingOutcome {

@@ -97,6 +97,52 @@ fn example_ceiling_parses_and_bad_input_is_named() {
     assert!(e.contains("cap.span") && e.contains("bay 1"), "{e}");
 }
 
+/// A ceiling file takes a design's `[uncertainty]` (issue 24): every bay's design carries it, a
+/// bad name is a named error, and the room's P_f bounds are Boole's over the bays' rows.
+#[test]
+fn a_ceiling_takes_uncertainty_for_every_bay() {
+    let table =
+        "\n[uncertainty]\n\"material.youngs_modulus\" = { dist = \"lognormal\", cov = 0.1 }\n";
+    let c = CeilingDesign::from_toml_str(&format!("{EXAMPLE_TOML}{table}")).unwrap();
+    let bays = c.bay_designs().unwrap();
+    assert_eq!(bays.len(), 3);
+    assert!(
+        bays.iter()
+            .all(|d| d.uncertainty == c.uncertainty && d.uncertainty.is_some())
+    );
+    let e = CeilingDesign::from_toml_str(&format!(
+        "{EXAMPLE_TOML}\n[uncertainty]\n\"material.colour\" = {{ dist = \"normal\", std = 1.0 }}\n"
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("material.colour"), "{e}");
+    // Rows as BayOutcome::summary writes them: bay 1 printed as two halves (P_f 1e-3 each),
+    // bay 2 as one (2e-3), bay 3 without reliability. The room: at least the largest bay's
+    // 2e-3, at most 2·1e-3 + 2e-3 = 4e-3; SORM's bounds only where every such bay has one.
+    let rows = vec![
+        serde_json::json!({"halves": 2, "ok": true, "reliability": {"beta": 3.09, "pf": 1e-3, "pf_sorm": 0.9e-3}}),
+        serde_json::json!({"halves": 1, "ok": true, "reliability": {"beta": 2.88, "pf": 2e-3, "pf_sorm": null}}),
+        serde_json::json!({"halves": 1, "ok": true, "reliability": null}),
+    ];
+    let s = kappe::commands::ceiling::ceiling_summary(&c, rows);
+    let r = &s["reliability"];
+    assert_eq!(r["bays_with_reliability"], 2);
+    let b: Vec<f64> = r["pf_bounds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    // Sums of three doubles: exact to round-off, so 1e-15 absolute at 4e-3.
+    assert!(
+        (b[0] - 2e-3).abs() < 1e-15 && (b[1] - 4e-3).abs() < 1e-15,
+        "{b:?}"
+    );
+    assert!(r["pf_sorm_bounds"].is_null());
+    let none = kappe::commands::ceiling::ceiling_summary(&c, vec![serde_json::json!({"ok": true})]);
+    assert!(none["reliability"].is_null());
+}
+
 /// The base-pose tolerance check runs inside the design pipeline (`[robot.tolerance]`): no error
 /// always passes; an error far beyond what the plan can absorb (0.3 m, 20°: the targets move out
 /// of the planned IK branch) fails, is reported in `summary.json`, and fails the design only
