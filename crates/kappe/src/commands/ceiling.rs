@@ -746,6 +746,24 @@ impl CeilingOutcome {
                     / 60.0
             ));
         }
+        // The room's chance of failure in one line (issue 24), when [uncertainty] is given.
+        let summary = self.summary();
+        let r = &summary["reliability"];
+        let bounds = |k: &str| {
+            r[k].as_array().and_then(|b| {
+                Some(format!(
+                    "[{:.3e}, {:.3e}]",
+                    b.first()?.as_f64()?,
+                    b.get(1)?.as_f64()?
+                ))
+            })
+        };
+        if let Some(f) = bounds("pf_bounds") {
+            t.push_str(&format!(
+                "  reliability: room P_f in {f} (FORM){} — between the likeliest bay and the sum over the printed halves\n",
+                bounds("pf_sorm_bounds").map_or(String::new(), |s| format!(", {s} (SORM)"))
+            ));
+        }
         t
     }
 
