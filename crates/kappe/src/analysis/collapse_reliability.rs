@@ -711,23 +711,12 @@ impl<'a> CapCollapseModel<'a> {
             .factor(self, index, x, true, &never)?
             .unwrap_or(f64::NAN);
         let path = self.direct(index, x)?;
-        // ‖∇ᵤg‖ at u* by central differences of the table (step 10⁻³ in u: truncation
-        // O(10⁻⁶) relative for a surface this smooth between nodes).
-        let h = 1e-3;
-        let mut norm2 = 0.0;
-        for i in 0..f.u_star.len() {
-            let mut up = f.u_star.clone();
-            let mut dn = f.u_star.clone();
-            up[i] += h;
-            dn[i] -= h;
-            let g = |u: &[f64]| {
+        let (relative_error, beta_error) =
+            design_point_error(&f.u_star, table, path.factor, |u| {
                 tables
                     .g(self, index, &model.x_from_u(u))
                     .map_err(|e| uerr("uncertainty", e.to_string()))
-            };
-            norm2 += ((g(&up)? - g(&dn)?) / (2.0 * h)).powi(2);
-        }
-        let dlog = (table.ln() - path.factor.ln()).abs();
+            })?;
         Ok(DesignPointCheck {
             state: index,
             beta: f.beta,
@@ -735,12 +724,8 @@ impl<'a> CapCollapseModel<'a> {
             table,
             path: path.factor,
             mode: path.mode.name().to_owned(),
-            relative_error: ((table - path.factor) / path.factor).abs(),
-            beta_error: if norm2 > 0.0 {
-                dlog / norm2.sqrt()
-            } else {
-                f64::INFINITY
-            },
+            relative_error,
+            beta_error,
         })
     }
 
@@ -832,6 +817,38 @@ impl CapCollapseTables {
             )),
         }
     }
+}
+
+/// A table's error at a design point u* against a direct path there (the cap's and the
+/// buildability objects' design-point checks): |table − path|/path, and as
+/// Δβ = |ln table − ln path|/‖∇ᵤg‖ with ‖∇ᵤg‖ by central differences of the table's `g` in u
+/// (step 10⁻³: truncation O(10⁻⁶) relative for a surface this smooth between nodes); Δβ is
+/// infinite where the gradient vanishes.
+///
+/// # Errors
+/// `g`'s.
+pub fn design_point_error<E>(
+    u_star: &[f64],
+    table: f64,
+    path: f64,
+    g: impl Fn(&[f64]) -> Result<f64, E>,
+) -> Result<(f64, f64), E> {
+    let h = 1e-3;
+    let mut norm2 = 0.0;
+    for i in 0..u_star.len() {
+        let mut up = u_star.to_vec();
+        let mut dn = u_star.to_vec();
+        up[i] += h;
+        dn[i] -= h;
+        norm2 += ((g(&up)? - g(&dn)?) / (2.0 * h)).powi(2);
+    }
+    let dlog = (table.ln() - path.ln()).abs();
+    let beta_error = if norm2 > 0.0 {
+        dlog / norm2.sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Ok((((table - path) / path).abs(), beta_error))
 }
 
 /// A state's collapse design point checked by a direct path.

@@ -96,7 +96,7 @@ use kappe_reliability::{EvalError, Fallible, FormResult, LimitState};
 
 use crate::analysis::collapse::{Collapse, CollapseMode};
 use crate::analysis::collapse_reliability::{
-    LogAxis, admit, coefficients, grid_point, grid_size, interpolate, least_log,
+    LogAxis, admit, coefficients, design_point_error, grid_point, grid_size, interpolate, least_log,
 };
 use crate::analysis::design_monte_carlo::bits;
 use crate::commands::buildability::{BuildState, Resolved, check_layers};
@@ -585,24 +585,11 @@ impl CollapseTables {
             .model
             .drifted(&p.drifts, th)
             .map_err(|e| uerr("uncertainty.drift", format!("state {n}: {e}")))?;
-        // ‖∇ᵤg‖ at u* by central differences of the table (closed-form cost; step 10⁻³ in
-        // u: truncation O(10⁻⁶) relative for a surface this smooth between nodes).
-        let h = 1e-3;
-        let mut norm2 = 0.0;
-        for i in 0..f.u_star.len() {
-            let mut up = f.u_star.clone();
-            let mut dn = f.u_star.clone();
-            up[i] += h;
-            dn[i] -= h;
-            let gu = self
-                .g(r, p, n, &model.x_from_u(&up))
-                .map_err(|e| uerr("uncertainty", e.to_string()))?;
-            let gd = self
-                .g(r, p, n, &model.x_from_u(&dn))
-                .map_err(|e| uerr("uncertainty", e.to_string()))?;
-            norm2 += ((gu - gd) / (2.0 * h)).powi(2);
-        }
-        let dlog = (table.ln() - path.factor.ln()).abs();
+        let (relative_error, beta_error) =
+            design_point_error(&f.u_star, table, path.factor, |u| {
+                self.g(r, p, n, &model.x_from_u(u))
+                    .map_err(|e| uerr("uncertainty", e.to_string()))
+            })?;
         Ok(DesignPointCheck {
             layers: n,
             beta: f.beta,
@@ -610,12 +597,8 @@ impl CollapseTables {
             table,
             path: path.factor,
             mode: path.mode,
-            relative_error: ((table - path.factor) / path.factor).abs(),
-            beta_error: if norm2 > 0.0 {
-                dlog / norm2.sqrt()
-            } else {
-                f64::INFINITY
-            },
+            relative_error,
+            beta_error,
         })
     }
 }

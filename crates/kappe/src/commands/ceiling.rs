@@ -716,8 +716,9 @@ impl CeilingOutcome {
             "mass [kg]",
             "time [min]"
         ));
-        for (i, bay) in self.bays.iter().enumerate() {
-            let row = bay.summary();
+        // Every bay's row once: the table's columns and the room's reliability line below.
+        let rows: Vec<Value> = self.bays.iter().map(BayOutcome::summary).collect();
+        for (i, (bay, row)) in self.bays.iter().zip(&rows).enumerate() {
             let governing = row["worst_constraint"]["name"].as_str().unwrap_or("-");
             t.push_str(&format!(
                 "  {:<4} {:>8.3} {:<22} {:<7} {:<16} {:>9} {:>10.1} {:>10.1}\n",
@@ -747,8 +748,7 @@ impl CeilingOutcome {
             ));
         }
         // The room's chance of failure in one line (issue 24), when [uncertainty] is given.
-        let summary = self.summary();
-        let r = &summary["reliability"];
+        let r = room_reliability(&rows).unwrap_or(Value::Null);
         let bounds = |k: &str| {
             r[k].as_array().and_then(|b| {
                 Some(format!(
