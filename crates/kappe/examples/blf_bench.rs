@@ -11,6 +11,8 @@ use std::time::Instant;
 
 use kappe::analysis::{AnalysisOptions, analyze};
 
+#[path = "common/caps.rs"]
+mod caps;
 #[path = "common/measure.rs"]
 mod measure;
 
@@ -68,14 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         run("default cap", &kappe::Design::default())?;
     }
     if which.is_empty() || which == "bay" {
-        // The bay of `examples/scaling.rs -- bay 1.5 4.0`: one half of a 1.5 m span between
-        // walls 4 m apart, graded mesh.
-        let text = "name = \"bench bay\"\n[ceiling]\nlength = 4.0\nends = \"both_walls\"\n\
-                    rise_ratio = 0.25\ntilt_deg = 25.0\n[[bay]]\nname = \"bay\"\nspan = 1.5\n\
-                    [analysis.grading]\n";
-        let c = kappe::commands::ceiling::CeilingDesign::from_toml_str(text)?;
-        let designs = c.bay_designs()?;
-        let d = designs.first().ok_or("no bay")?;
+        let d = &caps::bay_half()?;
         run("1.5 m × 4 m bay (one half)", d)?;
     }
     Ok(())

@@ -22,6 +22,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::buckling::state_material;
+use crate::analysis::graded::AnalysedState;
 use crate::analysis::shell::{NoShell, StateShell, state_shell};
 use crate::form::cap::Cap;
 use crate::form::states::Role;
@@ -196,8 +197,9 @@ pub fn accumulate(increments: &[Increment]) -> AsPrinted {
     }
 }
 
-/// The increment of print state `top` of `cap` (the full print-layer mesh, every layer a row;
-/// layer moduli at their ages in state `top` from `green`).
+/// The increment of print state `top` of `cap` on the mesh the buckling check meshes it with
+/// (every layer a row, or with `[analysis.grading]` the graded rows, the dropped nodes filled in
+/// by [`fill_graded`]; layer moduli at their ages in state `top` from `green`).
 ///
 /// # Errors
 /// A state that cannot be built, or whose shell is a mechanism.
@@ -209,12 +211,16 @@ pub fn cap_increment(
 ) -> Result<Increment, DesignError> {
     let state = cap.state(top)?;
     let mat = state_material(cap, options, top, green);
-    let shell = match state_shell(&state, &mat, 1) {
+    // `row_stride` > 1 thins the buckling mesh without filling in; the pass then keeps the full
+    // print-layer mesh (`shares_mesh`).
+    let grading = options.grading.as_ref().filter(|_| shares_mesh(options));
+    let analysed = AnalysedState::new(&state, grading);
+    let shell = match state_shell(analysed.state(), &mat, 1) {
         Ok(s) => s,
         // A single layer lies on the bed: every node is supported, nothing moves.
         Err(NoShell::SingleLayer) => return Ok(Increment::default()),
     };
-    let keys = node_keys(&state, &shell);
+    let keys = node_keys_of(&state, &analysed, &shell);
     let mut model = shell.model;
     let n_el = model.triangles.len();
     model.materials = (0..n_el)
@@ -231,14 +237,29 @@ pub fn cap_increment(
             m
         })
         .collect();
-    increment(&model, &keys).map_err(|e| DesignError::State {
+    let inc = increment(&model, &keys).map_err(|e| DesignError::State {
         state: top,
         message: format!("as-printed increment failed: {e}"),
+    })?;
+    Ok(match analysed {
+        AnalysedState::Graded(..) => fill_graded(&state, &inc),
+        AnalysedState::Full(_) => inc,
     })
 }
 
 /// The key of every node of a state's shell (None: a node not tracked, e.g. a column end).
 pub fn node_keys(state: &crate::form::states::State, shell: &StateShell) -> Vec<Option<NodeKey>> {
+    node_keys_of(state, &AnalysedState::Full(state), shell)
+}
+
+/// [`node_keys`] of a shell meshed from `analysed` (the state itself or its graded reduction):
+/// the keys name the nodes of `state`'s own network.
+pub fn node_keys_of(
+    state: &crate::form::states::State,
+    analysed: &AnalysedState<'_>,
+    shell: &StateShell,
+) -> Vec<Option<NodeKey>> {
+    // First network index of every layer: the network stores each layer contiguously.
     let mut first: HashMap<i32, usize> = HashMap::new();
     for (i, n) in state.network.nodes.iter().enumerate() {
         if n.role != Role::ColumnEnd {
@@ -248,11 +269,127 @@ pub fn node_keys(state: &crate::form::states::State, shell: &StateShell) -> Vec<
     shell
         .network_node
         .iter()
-        .map(|&i| {
+        .map(|&k| {
+            let i = analysed.full_index(k)?;
             let layer = state.network.nodes.get(i)?.layer;
             Some((layer, i.checked_sub(*first.get(&layer)?)?))
         })
         .collect()
+}
+
+/// An increment solved on a graded mesh (`crate::analysis::graded`) extended to every node of
+/// `state`: a thinned row's dropped nodes take the linear interpolation, by their index along
+/// the layer, between the kept nodes on either side; a dropped row takes the linear
+/// interpolation, by print index, between the nearest kept rows below and above, each read at
+/// the same fraction t = j/(m − 1) of its own length (node j of a row of m nodes). Row 0 and the
+/// top row are always kept, and every kept row keeps both feet, so every dropped node lies
+/// between kept ones. The increment's field is smooth with depth where the grading thins it
+/// (the newest `fine` layers, where the new weight acts, are all rows), the premise of the
+/// graded buckling mesh; docs/as-printed.md §5 measures what the filling costs in accuracy.
+pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Increment {
+    let known: HashMap<NodeKey, [f64; 3]> = inc.nodes.iter().map(|(k, _, d)| (*k, *d)).collect();
+    let net = &state.network;
+    let mut first: HashMap<i32, usize> = HashMap::new();
+    for (i, n) in net.nodes.iter().enumerate() {
+        if n.role != Role::ColumnEnd {
+            first.entry(n.layer).or_insert(i);
+        }
+    }
+    // Every row bottom-up: its nodes' keys and design positions.
+    let rows: Vec<Vec<(NodeKey, [f64; 3])>> = crate::analysis::shell::layer_rows(net)
+        .into_iter()
+        .map(|(layer, nodes)| {
+            let f = first.get(&layer).copied().unwrap_or(0);
+            nodes
+                .into_iter()
+                .filter_map(|i| {
+                    let x = net.nodes.get(i)?.xyz;
+                    Some(((layer, i.saturating_sub(f)), [x.x, x.y, x.z]))
+                })
+                .collect()
+        })
+        .collect();
+    // Along each row that kept any node.
+    let along: Vec<Option<Vec<[f64; 3]>>> = rows
+        .iter()
+        .map(|row| {
+            let vals: Vec<Option<[f64; 3]>> =
+                row.iter().map(|(k, _)| known.get(k).copied()).collect();
+            let kept: Vec<usize> = (0..vals.len()).filter(|&j| vals[j].is_some()).collect();
+            if kept.is_empty() {
+                return None;
+            }
+            Some(
+                (0..vals.len())
+                    .map(|j| {
+                        if let Some(v) = vals[j] {
+                            return v;
+                        }
+                        let b = kept.partition_point(|&k| k < j);
+                        match (b.checked_sub(1).map(|a| kept[a]), kept.get(b)) {
+                            (Some(a), Some(&c)) => {
+                                let w = (j - a) as f64 / (c - a) as f64;
+                                lerp(vals[a], vals[c], w)
+                            }
+                            (Some(a), None) => vals[a].unwrap_or_default(),
+                            (None, Some(&c)) => vals[c].unwrap_or_default(),
+                            (None, None) => [0.0; 3],
+                        }
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let kept_rows: Vec<usize> = (0..rows.len()).filter(|&q| along[q].is_some()).collect();
+    // The value of kept row `q` at the fraction `t` of its length.
+    let at = |q: usize, t: f64| -> [f64; 3] {
+        let Some(Some(v)) = along.get(q) else {
+            return [0.0; 3];
+        };
+        if v.len() < 2 {
+            return v.first().copied().unwrap_or_default();
+        }
+        let p = t * (v.len() - 1) as f64;
+        let a = (p.floor() as usize).min(v.len() - 2);
+        lerp(Some(v[a]), Some(v[a + 1]), p - a as f64)
+    };
+    let mut nodes = Vec::with_capacity(rows.iter().map(Vec::len).sum());
+    for (q, row) in rows.iter().enumerate() {
+        let m = row.len();
+        for (j, (key, x)) in row.iter().enumerate() {
+            let du = match &along[q] {
+                Some(v) => v[j],
+                None => {
+                    let t = if m > 1 {
+                        j as f64 / (m - 1) as f64
+                    } else {
+                        0.0
+                    };
+                    let b = kept_rows.partition_point(|&k| k < q);
+                    match (b.checked_sub(1).map(|a| kept_rows[a]), kept_rows.get(b)) {
+                        (Some(a), Some(&c)) => {
+                            let w = (q - a) as f64 / (c - a) as f64;
+                            lerp(Some(at(a, t)), Some(at(c, t)), w)
+                        }
+                        (Some(a), None) => at(a, t),
+                        (None, Some(&c)) => at(c, t),
+                        (None, None) => [0.0; 3],
+                    }
+                }
+            };
+            nodes.push((*key, *x, du));
+        }
+    }
+    Increment {
+        nodes,
+        residual: inc.residual,
+    }
+}
+
+/// (1 − w)·a + w·b.
+fn lerp(a: Option<[f64; 3]>, b: Option<[f64; 3]>, w: f64) -> [f64; 3] {
+    let (a, b) = (a.unwrap_or_default(), b.unwrap_or_default());
+    [0, 1, 2].map(|c| (1.0 - w) * a[c] + w * b[c])
 }
 
 /// The as-printed shape of `cap` over every print state (increments in parallel, summed in
@@ -300,8 +437,95 @@ pub fn cap_as_printed_given(
     Ok(accumulate(&increments))
 }
 
-/// Whether the buckling pass's print-layer mesh of a state is the as-printed pass's own mesh
-/// (every layer a row, no grading), so its factor of K can solve the state's increment.
+/// Whether the buckling pass's mesh of a state is the as-printed pass's own mesh (every layer a
+/// row, or graded: [`cap_increment`] solves on the graded rows and fills in the rest), so its
+/// factor of K can solve the state's increment. Not with `row_stride` > 1, a thinning of the
+/// buckling mesh alone.
 pub fn shares_mesh(options: &AnalysisOptions) -> bool {
-    options.row_stride <= 1 && options.grading.is_none()
+    options.row_stride <= 1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Linear interpolation reproduces a field linear in the row (print index) and in the
+    /// fraction along the layer exactly: so the filling of a graded increment adds no error of
+    /// its own where the field is linear, and every dropped node is reached (row 0 and the top
+    /// row kept, both feet of every kept row kept). Tolerance 1e-12: round-off of the weights.
+    #[test]
+    fn filling_a_graded_increment_reproduces_a_linear_field() {
+        let design = crate::Design::from_toml_str("[cap]\nlength = 0.2\n").expect("design");
+        let cap = crate::design_cap(&design, crate::Context::default()).expect("cap");
+        let top = cap.states.len() - 1;
+        let state = cap.state(top).expect("state");
+        // A grading that drops rows and thins them on this short cap.
+        let g = crate::input::analysis::Grading {
+            fine: 2,
+            zone_rows: 1,
+            max_stride: 8,
+            transverse: 2,
+            start_stride: 4,
+            ..Default::default()
+        };
+        let rows = crate::analysis::shell::layer_rows(&state.network);
+        let field = |q: usize, j: usize, m: usize| -> [f64; 3] {
+            let t = if m > 1 {
+                j as f64 / (m - 1) as f64
+            } else {
+                0.0
+            };
+            [q as f64, t, 2.0 * q as f64 - 3.0 * t + 1.0]
+        };
+        // Keys of the reduced network's nodes, each with the field at its full node.
+        let (_, map) = crate::analysis::graded::graded_state_map(&state, &g);
+        let mut first: HashMap<i32, usize> = HashMap::new();
+        for (i, n) in state.network.nodes.iter().enumerate() {
+            if n.role != Role::ColumnEnd {
+                first.entry(n.layer).or_insert(i);
+            }
+        }
+        let mut at: HashMap<usize, (usize, usize, usize)> = HashMap::new();
+        for (q, (_, nodes)) in rows.iter().enumerate() {
+            for (j, &i) in nodes.iter().enumerate() {
+                at.insert(i, (q, j, nodes.len()));
+            }
+        }
+        let kept: Vec<(NodeKey, [f64; 3], [f64; 3])> = map
+            .iter()
+            .map(|&i| {
+                let n = &state.network.nodes[i];
+                let (q, j, m) = at[&i];
+                ((n.layer, i - first[&n.layer]), [0.0; 3], field(q, j, m))
+            })
+            .collect();
+        let total: usize = rows.iter().map(|r| r.1.len()).sum();
+        assert!(kept.len() < total, "the grading drops nothing: {total}");
+        let filled = fill_graded(
+            &state,
+            &Increment {
+                nodes: kept,
+                residual: 0.0,
+            },
+        );
+        assert_eq!(filled.nodes.len(), total);
+        for (q, (layer, nodes)) in rows.iter().enumerate() {
+            for (j, &i) in nodes.iter().enumerate() {
+                let key = (*layer, i - first[layer]);
+                let got = filled
+                    .nodes
+                    .iter()
+                    .find(|n| n.0 == key)
+                    .map(|n| n.2)
+                    .expect("every node filled");
+                let want = field(q, j, nodes.len());
+                for c in 0..3 {
+                    assert!(
+                        (got[c] - want[c]).abs() < 1e-12,
+                        "{key:?}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -174,16 +174,17 @@ pub fn state_buckling(
             });
         }
     };
-    let keys = guess_keys(state, &analysed, &shell);
+    let keys = crate::analysis::asprinted::node_keys_of(state, &analysed, &shell);
     let start = request
         .guess
         .filter(|g| !g.is_empty())
         .map(|g| guess_start(&keys, g));
-    let own_mesh = crate::analysis::asprinted::shares_mesh(options);
-    let mut cases = Vec::new();
     // The as-printed increment's load: the strip that ends in the new top layer
-    // (`asprinted::cap_increment`).
-    let printed = request.printed && own_mesh;
+    // (`asprinted::cap_increment`, on this mesh, graded or not).
+    let printed = request.printed && crate::analysis::asprinted::shares_mesh(options);
+    // The bending part's stresses are per element of the state's own mesh.
+    let own_mesh = options.row_stride <= 1 && options.grading.is_none();
+    let mut cases = Vec::new();
     if printed {
         cases.push(kappe_fe::LoadCase {
             weight: shell
@@ -212,10 +213,15 @@ pub fn state_buckling(
         ..
     } = shell_buckling_run(&shell, state.index, options, start, &cases)?;
     let mut solved = solved.into_iter();
-    let increment = printed
-        .then(|| solved.next())
-        .flatten()
-        .map(|r| crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r));
+    let increment = printed.then(|| solved.next()).flatten().map(|r| {
+        let inc = crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r);
+        match &analysed {
+            crate::analysis::graded::AnalysedState::Graded(..) => {
+                crate::analysis::asprinted::fill_graded(state, &inc)
+            }
+            crate::analysis::graded::AnalysedState::Full(_) => inc,
+        }
+    });
     let stresses = match (unbalanced, bending_case, solved.next()) {
         (Some(u), Some(case), Some(st)) => Some(u.stresses(state, &shell, &case, &st)),
         _ => None,
@@ -421,31 +427,6 @@ fn fe_options(
     }
 }
 
-/// The [`ModeGuess`] key of every node of `shell` (a state's shell on `analysed`): (layer id,
-/// index of the node in its layer); `None` for a node without one.
-fn guess_keys(
-    state: &State,
-    analysed: &crate::analysis::graded::AnalysedState<'_>,
-    shell: &StateShell,
-) -> Vec<Option<(i32, usize)>> {
-    // First network index of every layer: the network stores each layer contiguously.
-    let mut first: HashMap<i32, usize> = HashMap::new();
-    for (i, n) in state.network.nodes.iter().enumerate() {
-        if n.role != crate::form::states::Role::ColumnEnd {
-            first.entry(n.layer).or_insert(i);
-        }
-    }
-    shell
-        .network_node
-        .iter()
-        .map(|&k| {
-            let i = analysed.full_index(k)?;
-            let layer = state.network.nodes.get(i)?.layer;
-            Some((layer, i.checked_sub(*first.get(&layer)?)?))
-        })
-        .collect()
-}
-
 /// A mode kept as a [`ModeGuess`] (the analysis's first pass keeps each state's mode 1 so)
 /// on the nodes of `shell`, the ungraded shell of `state` (the collapse check's,
 /// docs/collapse.md §3): `None` unless every node of `shell` has a key, no two share one and
@@ -453,7 +434,7 @@ fn guess_keys(
 /// and the guess was solved on this very mesh.
 pub fn mode_on_shell(state: &State, shell: &StateShell, mode: &ModeGuess) -> Option<Vec<[f64; 6]>> {
     let analysed = crate::analysis::graded::AnalysedState::new(state, None);
-    let keys = guess_keys(state, &analysed, shell);
+    let keys = crate::analysis::asprinted::node_keys_of(state, &analysed, shell);
     if keys.len() != mode.len() {
         return None;
     }
@@ -467,7 +448,7 @@ pub fn mode_on_shell(state: &State, shell: &StateShell, mode: &ModeGuess) -> Opt
         .collect()
 }
 
-/// A start vector per shell node (`keys`: [`guess_keys`]) from the mode `g`: a layer missing
+/// A start vector per shell node (`keys`: [`crate::analysis::asprinted::node_keys_of`]) from the mode `g`: a layer missing
 /// from `g` takes the nearest layer below it, a node without a key zero.
 fn guess_start(keys: &[Option<(i32, usize)>], g: &ModeGuess) -> Vec<[f64; 6]> {
     keys.iter()
@@ -501,7 +482,7 @@ pub fn state_refine(
     let Ok(shell) = state_shell(analysed.state(), material, options.row_stride) else {
         return Ok(None);
     };
-    let keys = guess_keys(state, &analysed, &shell);
+    let keys = crate::analysis::asprinted::node_keys_of(state, &analysed, &shell);
     let start = (!mode.is_empty()).then(|| guess_start(&keys, mode));
     let fe_opts = fe_options(options, None);
     let level = kappe_fe::MeshLevel {

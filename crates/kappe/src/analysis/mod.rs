@@ -56,7 +56,10 @@ pub use buckling::{
 pub use check::{Analysis, ConstraintResult, Request, StateAnalysis, Timings, analyze};
 
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
-pub use asprinted::{Increment, NodeKey, accumulate, cap_as_printed, increment, shares_mesh};
+pub use asprinted::{
+    AsPrinted, Increment, NodeKey, StateDeviation, accumulate, cap_as_printed, increment,
+    shares_mesh,
+};
 pub use bending::corrugated_stresses;
 pub use blf_sensitivity::{blf_derivatives, time_state_blf, time_state_blf_ages};
 pub use buckling::{BucklingRequest, ModeGuess, StateSolve, state_refine};
