@@ -255,9 +255,7 @@
       return;
     }
     if (!current || msg.generation !== current.generation) return;
-    if (msg.max_split === 1) {
-      for (const f of JSON.parse(msg.result)) owner.set(f.state, w);
-    }
+    if (msg.max_split === 1) owner.set(msg.state, w);
     pending.push(msg.result);
     const starving = !queue.length || pool.some((x) => !x.busy);
     const wait = lastFlush + FLUSH_MS - performance.now();

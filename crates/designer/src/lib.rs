@@ -22,10 +22,10 @@
 
 pub mod page;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
-use kappe::analysis::WorstElement;
 use kappe::analysis::{BucklingStatus, ModeGuess, StateBuckling};
+use kappe::analysis::{Increment, WorstElement};
 use kappe::analysis::{RefineBatch, RefineSolves};
 use kappe::analysis::{StateFe, analysis_green, fe_runs, state_fe, state_fe_refine};
 use kappe::{Cap, Design, DesignError};
@@ -89,6 +89,50 @@ pub struct FeWire {
     /// [`StateBuckling::convergence`] (a solve of the mesh-error pass; `None` in the first pass).
     #[serde(default)]
     pub convergence: Option<ConvergedWire>,
+    /// The state's as-printed increment, solved inside its first-pass buckling solve
+    /// ([`kappe::analysis::FeRequest::extra`]) so that the page's last evaluation does not
+    /// factorize every state again on its single thread (`None`: not solved there).
+    #[serde(default)]
+    pub printed: Option<IncrementWire>,
+}
+
+/// [`Increment`] on the wire, flat: per node its key (layer id, index in the layer), its design
+/// position and Δu (three numbers each). JSON numbers round-trip f64 exactly.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IncrementWire {
+    residual: f64,
+    layers: Vec<i32>,
+    indices: Vec<usize>,
+    x: Vec<f64>,
+    du: Vec<f64>,
+}
+
+impl From<&Increment> for IncrementWire {
+    fn from(i: &Increment) -> Self {
+        IncrementWire {
+            residual: i.residual,
+            layers: i.nodes.iter().map(|n| n.0.0).collect(),
+            indices: i.nodes.iter().map(|n| n.0.1).collect(),
+            x: i.nodes.iter().flat_map(|n| n.1).collect(),
+            du: i.nodes.iter().flat_map(|n| n.2).collect(),
+        }
+    }
+}
+
+impl From<IncrementWire> for Increment {
+    fn from(w: IncrementWire) -> Self {
+        let three = |v: &[f64]| [v[0], v[1], v[2]];
+        Increment {
+            nodes: w
+                .layers
+                .iter()
+                .zip(&w.indices)
+                .zip(w.x.chunks_exact(3).zip(w.du.chunks_exact(3)))
+                .map(|((&l, &i), (x, d))| ((l, i), three(x), three(d)))
+                .collect(),
+            residual: w.residual,
+        }
+    }
 }
 
 fn first_pass() -> usize {
@@ -177,8 +221,8 @@ impl From<WorstWire> for WorstElement {
 }
 
 impl FeWire {
-    /// `f` solved with `blf_max_split = max_split`.
-    fn of(f: &StateFe, max_split: usize) -> Self {
+    /// `f` solved with `blf_max_split = max_split`, with its as-printed increment if solved.
+    fn of(f: &StateFe, max_split: usize, printed: Option<&Increment>) -> Self {
         FeWire {
             state: f.state,
             status: f.buckling.status,
@@ -194,6 +238,7 @@ impl FeWire {
             }),
             max_split,
             convergence: f.buckling.convergence.as_ref().map(ConvergedWire::from),
+            printed: printed.map(IncrementWire::from),
         }
     }
 }
@@ -314,6 +359,8 @@ pub struct SessionCore {
     fe: BTreeMap<usize, StateFe>,
     /// The mesh-error pass's solves so far (the workers make them when the pass asks).
     refined: RefineSolves,
+    /// The first pass's as-printed increments so far, by state.
+    printed: HashMap<usize, Increment>,
     generation: u64,
 }
 
@@ -332,6 +379,7 @@ impl SessionCore {
             runs: Vec::new(),
             fe: BTreeMap::new(),
             refined: RefineSolves::new(),
+            printed: HashMap::new(),
             generation: 0,
         }
     }
@@ -353,12 +401,18 @@ impl SessionCore {
             .map_err(|e| FieldError::of(&e))?;
         let runs = fe_runs(&design.analysis, cap.states.len());
         // The quick pass must succeed before the design is taken (e.g. a bad [schedule]).
-        let outcome = evaluate(&cap, &BTreeMap::new(), &RefineSolves::new())
-            .map_err(|e| FieldError::of(&e))?;
+        let outcome = evaluate(
+            &cap,
+            &BTreeMap::new(),
+            &RefineSolves::new(),
+            &HashMap::new(),
+        )
+        .map_err(|e| FieldError::of(&e))?;
         self.text = text.to_string();
         self.runs = runs;
         self.fe.clear();
         self.refined.clear();
+        self.printed.clear();
         self.generation += 1;
         let view = view(&cap);
         let report = report(&outcome, &self.runs);
@@ -397,7 +451,10 @@ impl SessionCore {
                 field: String::new(),
                 message: format!("worker results: {e}"),
             })?;
-            for w in wires {
+            for mut w in wires {
+                if let Some(p) = w.printed.take() {
+                    self.printed.insert(w.state, Increment::from(p));
+                }
                 match w.max_split {
                     0 | 1 => {
                         self.fe.insert(w.state, StateFe::from(w));
@@ -408,18 +465,20 @@ impl SessionCore {
                 }
             }
         }
-        let outcome = evaluate(cap, &self.fe, &self.refined).map_err(|e| FieldError::of(&e))?;
+        let outcome = evaluate(cap, &self.fe, &self.refined, &self.printed)
+            .map_err(|e| FieldError::of(&e))?;
         Ok(report(&outcome, &self.runs))
     }
 }
 
 /// The verdict of `cap` with the buckling results so far (`fe`: first pass, `refined`: the
-/// mesh-error pass's solves): [`kappe::run::evaluate`] with the design's own analysis options
-/// and no robot plan.
+/// mesh-error pass's solves, `printed`: the first pass's as-printed increments):
+/// [`kappe::run::evaluate`] with the design's own analysis options and no robot plan.
 fn evaluate(
     cap: &Cap,
     fe: &BTreeMap<usize, StateFe>,
     refined: &RefineSolves,
+    printed: &HashMap<usize, Increment>,
 ) -> Result<kappe::Outcome, DesignError> {
     let options = kappe::Options {
         analysis: Some(cap.design.analysis.clone()),
@@ -432,6 +491,18 @@ fn evaluate(
         Some(kappe::Given {
             fe: fe.values().cloned().collect(),
             refined: refined.clone(),
+            // Used only once every state is in (the as-printed pass runs on a complete
+            // analysis), so cloned only then.
+            increments: if fe.len()
+                >= fe_runs(&cap.design.analysis, cap.states.len())
+                    .iter()
+                    .map(Vec::len)
+                    .sum()
+            {
+                printed.clone()
+            } else {
+                HashMap::new()
+            },
         }),
         &kappe::no_progress,
     )
@@ -577,13 +648,17 @@ impl WorkerCore {
         for &i in run {
             let request = kappe::analysis::FeRequest {
                 green: self.green.as_ref(),
-                extra: false,
+                // The first pass also solves the state's as-printed increment on its factor of
+                // K, as `kappe design` does.
+                extra: max_split == 1,
             };
+            let mut printed = None;
             let fe = match (max_split, self.first.get(&i)) {
                 (1, _) => {
-                    let fe = state_fe(cap, &options, i, &mut self.guess, &request)
-                        .map_err(|e| FieldError::of(&e))?
-                        .fe;
+                    let solved = state_fe(cap, &options, i, &mut self.guess, &request)
+                        .map_err(|e| FieldError::of(&e))?;
+                    printed = solved.increment;
+                    let fe = solved.fe;
                     // What `analyze` keeps for its mesh-error pass (without a green-state
                     // model, whose path starts cold).
                     if let (None, Some(g), Some(&f1)) =
@@ -602,7 +677,7 @@ impl WorkerCore {
                         .fe
                 }
             };
-            let wire = FeWire::of(&fe, max_split);
+            let wire = FeWire::of(&fe, max_split, printed.as_ref());
             on_state(serde_json::to_string(&[wire]).unwrap_or_default());
         }
         Ok(())

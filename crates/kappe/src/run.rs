@@ -217,6 +217,9 @@ pub struct Given {
     pub fe: Vec<crate::analysis::check::StateFe>,
     /// The mesh-error pass's solves ([`crate::analysis::check::RefineBatch`] asks for them).
     pub refined: crate::analysis::check::RefineSolves,
+    /// The as-printed increments the first pass's buckling solves gave (by state; asked with
+    /// [`crate::analysis::FeRequest::extra`]): the as-printed pass solves only the others.
+    pub increments: std::collections::HashMap<usize, crate::analysis::Increment>,
 }
 
 fn after_form(
@@ -262,9 +265,9 @@ fn after_form(
     check(stop)?;
     let schedule = run_schedule(&cap, robot.as_ref())?;
     let fe = Ticker::new(on_progress, stop, Stage::Analysis);
-    let (given_fe, refined) = match given {
-        Some(g) => (Some(g.fe), Some(g.refined)),
-        None => (None, None),
+    let (given_fe, refined, increments) = match given {
+        Some(g) => (Some(g.fe), Some(g.refined), g.increments),
+        None => (None, None, Default::default()),
     };
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
@@ -295,6 +298,7 @@ fn after_form(
                     schedule: Some(&schedule),
                     fe: given_fe,
                     refined,
+                    increments,
                     context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
                 },
             )?),

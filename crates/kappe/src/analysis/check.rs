@@ -625,6 +625,9 @@ pub struct Request<'a> {
     /// solves nothing itself: it stops at the first batch this lacks and names it in
     /// [`Analysis::refine_pending`]. `None`: the pass solves its states here, in turn.
     pub refined: Option<RefineSolves>,
+    /// With [`Self::fe`]: the as-printed increments the buckling solves made elsewhere gave
+    /// (by state, [`FeRequest::extra`]); the as-printed pass solves only the other states.
+    pub increments: std::collections::HashMap<usize, Increment>,
     /// Progress (one step per buckling analysis finished) and cancellation (checked before every
     /// state's rebuild and buckling solve).
     pub context: Context<'a>,
@@ -647,6 +650,7 @@ pub fn analyze(
             request.schedule,
             fe,
             request.refined.as_ref(),
+            request.increments,
             request.context,
         ),
         None => analyze_all(cap, options, request.schedule, request.context),
@@ -660,6 +664,7 @@ fn analyze_from_fe(
     schedule: Option<&crate::schedule::Schedule>,
     fe: Vec<StateFe>,
     refined: Option<&RefineSolves>,
+    increments: std::collections::HashMap<usize, Increment>,
     context: Context<'_>,
 ) -> Result<Analysis, DesignError> {
     options.validate()?;
@@ -725,7 +730,7 @@ fn analyze_from_fe(
         &interpolated,
         (t_all, 0.0),
         complete,
-        Default::default(),
+        increments,
         Default::default(),
         &Default::default(),
         context.stop_flag(),
