@@ -81,6 +81,7 @@ pub struct Model {
     pub(crate) trail_u: Vec<usize>,
     pub(crate) trail_v: Vec<usize>,
     pub(crate) lengths: Vec<f64>,
+    /// Per trail edge; empty when no edge is plane-cut ([`Model::from_trails`]).
     pub(crate) planes: Vec<Option<UnitPlane>>,
     pub(crate) dev_u: Vec<usize>,
     pub(crate) dev_v: Vec<usize>,
@@ -690,7 +691,8 @@ impl Model {
             sequence: schedule.sequence,
             trail_u,
             trail_v,
-            planes: vec![None; lengths.len()],
+            // No plane-cut edges (an empty list: no per-edge `None` to write for every state).
+            planes: Vec::new(),
             lengths,
             dev_u,
             dev_v,

@@ -150,17 +150,20 @@ fn small() -> IndexedNetwork {
     }
 }
 
+/// A change that breaks one check of a valid network.
+type Break = dyn Fn(&mut IndexedNetwork);
+
 /// Each documented check fails on a network that breaks only it, with the error `Model::new`
 /// gives the equivalent topology (or `InvalidNetwork` for arrays that disagree).
 #[test]
 fn from_trails_rejects_what_breaks_its_checks() {
     assert!(Model::from_trails(small()).is_ok());
-    let kind = |f: &dyn Fn(&mut IndexedNetwork)| {
+    let kind = |f: &Break| {
         let mut net = small();
         f(&mut net);
         Model::from_trails(net).map(|_| ()).unwrap_err()
     };
-    let cases: [(&str, &dyn Fn(&mut IndexedNetwork)); 11] = [
+    let cases: [(&str, &Break); 11] = [
         ("invalid_network", &|n| {
             n.loads.pop();
         }),
