@@ -179,7 +179,7 @@ fn sweep<T: Scalar>(model: &Model, inp: &Inputs<'_, T>, with_indirect: bool, st:
         let Some((e, s)) = step.out else { continue };
         let u = safe_unit(&r);
         let mut lambda = inp.lengths[e];
-        if let Some(plane) = &model.planes[e] {
+        if let Some(Some(plane)) = model.planes.get(e) {
             let nrm: Vector3<T> = lift(&plane.normal);
             let c = dot(&nrm, &u);
             // compas: no intersection when |c| < 1e-6 (keep λ_e); a cut of exactly 0 is

@@ -214,6 +214,9 @@ pub enum CemError {
     /// Prescribed positions do not match the topology (fixed-geometry force pass).
     #[error("{0}")]
     PositionMismatch(String),
+    /// The arrays of a network given by index ([`crate::model::IndexedNetwork`]) disagree.
+    #[error("network given by index: {0}")]
+    InvalidNetwork(String),
     /// A constrained form-finding problem is ill-posed.
     #[error("optimization problem: {0}")]
     InvalidProblem(String),
@@ -247,6 +250,7 @@ impl CemError {
             Self::NotConverged { .. } => "not_converged",
             Self::NumericalBreakdown { .. } => "numerical_breakdown",
             Self::PositionMismatch(_) => "position_mismatch",
+            Self::InvalidNetwork(_) => "invalid_network",
             Self::InvalidProblem(_) => "invalid_problem",
         }
     }

@@ -7,7 +7,8 @@
 //!
 //! * [`Topology`] / [`TopologyBuilder`]: nodes with loads and supports, trail edges with
 //!   signed lengths λ, deviation edges with signed forces μ (negative = compression).
-//! * [`Model`]: validated trails, sequences and the solve schedule ([`Model::new`]).
+//! * [`Model`]: validated trails, sequences and the solve schedule ([`Model::new`]; for
+//!   networks a program builds by index, [`Model::from_trails`]).
 //! * [`solve`] / [`Model::solve`]: the sequential nodal equilibrium
 //!   `r_n = r_in − q_n − D_n`, `x_next = x_n + λ·û(r_n)`, giving an [`Equilibrium`]
 //!   with positions, trail forces `F = copysign(‖r‖, λ)`, reactions `R = r` at supports,
@@ -56,7 +57,7 @@ pub use equilibrium::{
 };
 pub use error::CemError;
 pub use fixed_geometry::{ForcePass, force_pass};
-pub use model::Model;
+pub use model::{IndexedNetwork, Model};
 pub use optimize::{
     Bounds, Goal, OptimizeOptions, OptimizeResult, OptimizeStatus, Parameter, ParameterKind,
     Problem, WeightedGoal, optimize,

@@ -81,6 +81,7 @@ pub struct Model {
     pub(crate) trail_u: Vec<usize>,
     pub(crate) trail_v: Vec<usize>,
     pub(crate) lengths: Vec<f64>,
+    /// Per trail edge; empty when no edge is plane-cut ([`Model::from_trails`]).
     pub(crate) planes: Vec<Option<UnitPlane>>,
     pub(crate) dev_u: Vec<usize>,
     pub(crate) dev_v: Vec<usize>,
@@ -96,6 +97,26 @@ pub struct Model {
     pub(crate) has_indirect: bool,
     pub(crate) aux: Vec<AuxData>,
     pub(crate) n_input_trail_edges: usize,
+}
+
+/// A network given by node index, for [`Model::from_trails`]: nodes `0..n` (positions, loads,
+/// support flags), its trails and its deviation edges.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IndexedNetwork {
+    /// Free-text name (copied to outputs).
+    pub name: String,
+    /// Node positions (the prescribed ones of origins; starting guesses elsewhere).
+    pub positions: Vec<Vector3<f64>>,
+    /// Node loads (force vectors).
+    pub loads: Vec<Vector3<f64>>,
+    /// Whether each node is a support; a support on no trail is a reaction node.
+    pub supports: Vec<bool>,
+    /// Every trail of two or more nodes: node indices from the origin to the support.
+    pub trails: Vec<Vec<usize>>,
+    /// Signed length λ of every trail edge (`< 0` compression), trail by trail, origin end first.
+    pub lengths: Vec<f64>,
+    /// Deviation edges: the two node indices and the signed force μ (`< 0` compression).
+    pub deviation_edges: Vec<(usize, usize, f64)>,
 }
 
 /// compas `normalize_vector`: v/‖v‖, and the zero vector for v = 0.
@@ -122,12 +143,146 @@ fn by_sequence(steps: Vec<(usize, Step)>) -> Vec<Step> {
     for k in 0..=top {
         start[k + 1] += start[k];
     }
-    let mut out: Vec<Option<Step>> = vec![None; len];
+    // Every slot is written once: the counts place each step in its own slot.
+    let mut out = vec![Step { node: 0, out: None }; len];
     for (k, s) in steps {
-        out[start[k]] = Some(s);
+        out[start[k]] = s;
         start[k] += 1;
     }
-    out.into_iter().flatten().collect()
+    out
+}
+
+/// Whether each node is the origin (first node) of a trail.
+fn origins(n: usize, trails: &[TrailData]) -> Vec<bool> {
+    let mut is_origin = vec![false; n];
+    for t in trails {
+        if let Some(&o) = t.nodes.first() {
+            is_origin[o] = true;
+        }
+    }
+    is_origin
+}
+
+/// What both constructors derive from the built trails (steps 4–5 of the module docs): the
+/// sequences, the direct/indirect flags, the deviation adjacency and the step schedule.
+struct Schedule {
+    sequence: Vec<usize>,
+    direct: Vec<bool>,
+    has_indirect: bool,
+    adj_start: Vec<usize>,
+    adj_split: Vec<usize>,
+    adj: Vec<Adj>,
+    steps: Vec<Step>,
+}
+
+impl Schedule {
+    /// `trails` in processing order with their (shifted) starts, `shifted[k]` whether trail `k`
+    /// has an explicit shift, `tdeg` the trail-edge count of every node, and the deviation edges'
+    /// ends. Unshifted reaction nodes get their start here.
+    fn new(
+        trails: &mut [TrailData],
+        shifted: &[bool],
+        is_support: &[bool],
+        tdeg: &[usize],
+        dev_u: &[usize],
+        dev_v: &[usize],
+    ) -> Self {
+        let n = is_support.len();
+        let mut sequence = vec![0usize; n];
+        for t in trails.iter() {
+            for (j, &node) in t.nodes.iter().enumerate() {
+                sequence[node] = t.start + j;
+            }
+        }
+
+        // Reaction nodes follow the sequence of their (trail) neighbours.
+        let is_reaction: Vec<bool> = (0..n).map(|i| is_support[i] && tdeg[i] == 0).collect();
+        // usize::MAX: no trail neighbour (the start stays 0).
+        let mut reaction_seq = vec![usize::MAX; n];
+        for (&u, &v) in dev_u.iter().zip(dev_v) {
+            for (a, b) in [(u, v), (v, u)] {
+                if is_reaction[a] && !is_reaction[b] {
+                    reaction_seq[a] = match reaction_seq[a] {
+                        usize::MAX => sequence[b],
+                        s => s.max(sequence[b]),
+                    };
+                }
+            }
+        }
+        for (k, t) in trails.iter_mut().enumerate() {
+            if let [only] = t.nodes[..]
+                && is_reaction[only]
+                && !shifted[k]
+            {
+                t.start = match reaction_seq[only] {
+                    usize::MAX => 0,
+                    s => s,
+                };
+                sequence[only] = t.start;
+            }
+        }
+
+        // Deviation adjacency (CSR), direct entries first.
+        let direct: Vec<bool> = dev_u
+            .iter()
+            .zip(dev_v)
+            .map(|(&u, &v)| sequence[u] == sequence[v])
+            .collect();
+        let has_indirect = direct.iter().any(|d| !d);
+        let mut count = vec![0usize; n + 1];
+        for (&u, &v) in dev_u.iter().zip(dev_v) {
+            count[u + 1] += 1;
+            count[v + 1] += 1;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let adj_start = count;
+        let mut fill = adj_start.clone();
+        let mut adj = vec![Adj { other: 0, edge: 0 }; adj_start[n]];
+        for pass_direct in [true, false] {
+            for (e, (&u, &v)) in dev_u.iter().zip(dev_v).enumerate() {
+                if direct[e] != pass_direct {
+                    continue;
+                }
+                for (a, b) in [(u, v), (v, u)] {
+                    adj[fill[a]] = Adj { other: b, edge: e };
+                    fill[a] += 1;
+                }
+            }
+        }
+        let mut adj_split = vec![0usize; n];
+        for i in 0..n {
+            let range = adj_start[i]..adj_start[i + 1];
+            adj_split[i] = range.start
+                + adj[range.clone()]
+                    .iter()
+                    .take_while(|a| direct[a.edge])
+                    .count();
+        }
+
+        // Schedule: k-major, trail order within a sequence (stable sort keeps trail order).
+        let mut steps: Vec<(usize, Step)> = Vec::with_capacity(n);
+        for t in trails.iter() {
+            for (j, &node) in t.nodes.iter().enumerate() {
+                let out = match (t.edges.get(j), t.nodes.get(j + 1)) {
+                    (Some(&e), Some(&next)) => Some((e, next)),
+                    _ => None,
+                };
+                steps.push((t.start + j, Step { node, out }));
+            }
+        }
+        let steps = by_sequence(steps);
+        Schedule {
+            sequence,
+            direct,
+            has_indirect,
+            adj_start,
+            adj_split,
+            adj,
+            steps,
+        }
+    }
 }
 
 impl Model {
@@ -293,12 +448,7 @@ impl Model {
             });
         }
 
-        let mut is_origin = vec![false; n];
-        for t in &trails {
-            if let Some(&o) = t.nodes.first() {
-                is_origin[o] = true;
-            }
-        }
+        let is_origin = origins(n, &trails);
         for (i, node) in topo.nodes.iter().enumerate() {
             if let Some(given) = node.origin
                 && given != is_origin[i]
@@ -315,7 +465,7 @@ impl Model {
             }
         }
 
-        // Sequences and shifts.
+        // Shifts.
         let mut trail_of_origin: Vec<Option<usize>> = vec![None; n];
         for (k, t) in trails.iter().enumerate() {
             if let Some(&o) = t.nodes.first() {
@@ -334,12 +484,6 @@ impl Model {
             shifted[k] = true;
             trails[k].start = s.start;
         }
-        let mut sequence = vec![0usize; n];
-        for t in &trails {
-            for (j, &node) in t.nodes.iter().enumerate() {
-                sequence[node] = t.start + j;
-            }
-        }
         let dev_u: Vec<usize> = topo
             .deviation_edges
             .iter()
@@ -351,79 +495,7 @@ impl Model {
             .map(|e| index.get(&e.v).copied().unwrap_or_default())
             .collect();
         let forces: Vec<f64> = topo.deviation_edges.iter().map(|e| e.force).collect();
-
-        // Reaction nodes follow the sequence of their (trail) neighbours.
-        let is_reaction: Vec<bool> = (0..n).map(|i| is_support[i] && tdeg[i] == 0).collect();
-        let mut reaction_seq: Vec<Option<usize>> = vec![None; n];
-        for (&u, &v) in dev_u.iter().zip(&dev_v) {
-            for (a, b) in [(u, v), (v, u)] {
-                if is_reaction[a] && !is_reaction[b] {
-                    let s = reaction_seq[a].map_or(sequence[b], |s| s.max(sequence[b]));
-                    reaction_seq[a] = Some(s);
-                }
-            }
-        }
-        for (k, t) in trails.iter_mut().enumerate() {
-            if let [only] = t.nodes[..]
-                && is_reaction[only]
-                && !shifted[k]
-            {
-                t.start = reaction_seq[only].unwrap_or(0);
-                sequence[only] = t.start;
-            }
-        }
-
-        // Deviation adjacency (CSR), direct entries first.
-        let direct: Vec<bool> = dev_u
-            .iter()
-            .zip(&dev_v)
-            .map(|(&u, &v)| sequence[u] == sequence[v])
-            .collect();
-        let has_indirect = direct.iter().any(|d| !d);
-        let mut count = vec![0usize; n + 1];
-        for (&u, &v) in dev_u.iter().zip(&dev_v) {
-            count[u + 1] += 1;
-            count[v + 1] += 1;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let adj_start = count;
-        let mut fill = adj_start.clone();
-        let mut adj = vec![Adj { other: 0, edge: 0 }; adj_start[n]];
-        for pass_direct in [true, false] {
-            for (e, (&u, &v)) in dev_u.iter().zip(&dev_v).enumerate() {
-                if direct[e] != pass_direct {
-                    continue;
-                }
-                for (a, b) in [(u, v), (v, u)] {
-                    adj[fill[a]] = Adj { other: b, edge: e };
-                    fill[a] += 1;
-                }
-            }
-        }
-        let mut adj_split = vec![0usize; n];
-        for i in 0..n {
-            let range = adj_start[i]..adj_start[i + 1];
-            adj_split[i] = range.start
-                + adj[range.clone()]
-                    .iter()
-                    .take_while(|a| direct[a.edge])
-                    .count();
-        }
-
-        // Schedule: k-major, trail order within a sequence (stable sort keeps trail order).
-        let mut steps: Vec<(usize, Step)> = Vec::with_capacity(n);
-        for t in &trails {
-            for (j, &node) in t.nodes.iter().enumerate() {
-                let out = match (t.edges.get(j), t.nodes.get(j + 1)) {
-                    (Some(&e), Some(&next)) => Some((e, next)),
-                    _ => None,
-                };
-                steps.push((t.start + j, Step { node, out }));
-            }
-        }
-        let steps = by_sequence(steps);
+        let schedule = Schedule::new(&mut trails, &shifted, &is_support, &tdeg, &dev_u, &dev_v);
 
         Ok(Self {
             name: topo.name.clone(),
@@ -433,7 +505,7 @@ impl Model {
             loads,
             is_support,
             is_origin,
-            sequence,
+            sequence: schedule.sequence,
             trail_u,
             trail_v,
             lengths,
@@ -441,14 +513,198 @@ impl Model {
             dev_u,
             dev_v,
             forces,
-            direct,
+            direct: schedule.direct,
             trails,
-            steps,
-            adj_start,
-            adj_split,
-            adj,
-            has_indirect,
+            steps: schedule.steps,
+            adj_start: schedule.adj_start,
+            adj_split: schedule.adj_split,
+            adj: schedule.adj,
+            has_indirect: schedule.has_indirect,
             aux,
+            n_input_trail_edges,
+        })
+    }
+
+    /// Build the model of a network its caller constructed by node index ([`IndexedNetwork`]),
+    /// without the element checks and the trail search of [`Model::new`]: for programs that
+    /// build many valid networks (Kappe's print states, one per printed layer, on every change of
+    /// a design) and would otherwise spend most of a force pass validating them.
+    ///
+    /// The model is the one [`Model::new`] builds from the equivalent [`Topology`] (node ids
+    /// `0..n`, the trails' edges in the order given, origin end first, then the deviation edges;
+    /// no auxiliary trails or shifts): the same trails, in the order of their supports' indices,
+    /// the same sequences, adjacency and schedule (one implementation builds them), so a solve or
+    /// force pass gives the same numbers bit for bit.
+    ///
+    /// Checked (linear time, no hashing): the arrays agree in length, every index names a node,
+    /// every trail has at least two nodes, ends at a support and holds no other support, no node
+    /// is on two trails, every non-support node is on a trail, there is a support, no deviation
+    /// edge joins a node to itself. **Not** checked (the caller's construction guarantees them;
+    /// use [`Model::new`] for anything a user can feed in): finite loads, lengths and forces, and
+    /// no two edges joining the same two nodes.
+    ///
+    /// # Errors
+    /// The first failed check, as [`Model::new`] would name it ([`CemError::InvalidNetwork`] for
+    /// arrays of different lengths).
+    pub fn from_trails(net: IndexedNetwork) -> Result<Self, CemError> {
+        let IndexedNetwork {
+            name,
+            positions,
+            loads,
+            supports,
+            trails: given,
+            lengths,
+            deviation_edges,
+        } = net;
+        let n = positions.len();
+        if loads.len() != n || supports.len() != n {
+            return Err(CemError::InvalidNetwork(format!(
+                "{n} positions, {} loads and {} support flags; give one of each per node",
+                loads.len(),
+                supports.len()
+            )));
+        }
+        let n_edges: usize = given.iter().map(|t| t.len().saturating_sub(1)).sum();
+        if lengths.len() != n_edges {
+            return Err(CemError::InvalidNetwork(format!(
+                "{} trail lengths for {n_edges} trail edges; give one per edge, trail by trail",
+                lengths.len()
+            )));
+        }
+        let id = |i: usize| i as NodeId;
+        // Each node's trail and the first edge index of every trail (edges numbered trail by
+        // trail, as the equivalent topology lists them).
+        let mut trail_of = vec![usize::MAX; n];
+        let mut tdeg = vec![0usize; n];
+        let mut trail_u = Vec::with_capacity(n_edges);
+        let mut trail_v = Vec::with_capacity(n_edges);
+        let mut first_edge = Vec::with_capacity(given.len());
+        for (k, t) in given.iter().enumerate() {
+            let (Some(&support), true) = (t.last(), t.len() >= 2) else {
+                return Err(CemError::InvalidNetwork(format!(
+                    "trail {k} has {} node(s); a trail has at least two (a support alone is a \
+                     reaction node)",
+                    t.len()
+                )));
+            };
+            for (j, &i) in t.iter().enumerate() {
+                if i >= n {
+                    return Err(CemError::UnknownNode {
+                        id: id(i),
+                        context: format!("trail {k}"),
+                    });
+                }
+                if trail_of[i] != usize::MAX {
+                    return Err(CemError::NodeOnTwoTrails {
+                        id: id(i),
+                        count: 2,
+                        edges: format!("trails {} and {k}", trail_of[i]),
+                    });
+                }
+                trail_of[i] = k;
+                tdeg[i] = if j == 0 || j + 1 == t.len() { 1 } else { 2 };
+                if supports[i] && i != support {
+                    return Err(if j == 0 {
+                        CemError::TrailWithTwoSupports {
+                            first: id(support),
+                            second: id(i),
+                        }
+                    } else {
+                        CemError::SupportInsideTrail { id: id(i) }
+                    });
+                }
+            }
+            if !supports[support] {
+                return Err(CemError::TrailWithoutSupport {
+                    nodes: t.iter().map(|&i| id(i)).collect(),
+                });
+            }
+            first_edge.push(trail_u.len());
+            for w in t.windows(2) {
+                trail_u.push(w[0]);
+                trail_v.push(w[1]);
+            }
+        }
+        if !supports.iter().any(|&s| s) {
+            return Err(CemError::NoSupport);
+        }
+        if let Some(i) = (0..n).find(|&i| trail_of[i] == usize::MAX && !supports[i]) {
+            return Err(CemError::UnassignedNode { id: id(i) });
+        }
+        let mut dev_u = Vec::with_capacity(deviation_edges.len());
+        let mut dev_v = Vec::with_capacity(deviation_edges.len());
+        let mut forces = Vec::with_capacity(deviation_edges.len());
+        for &(u, v, force) in &deviation_edges {
+            for i in [u, v] {
+                if i >= n {
+                    return Err(CemError::UnknownNode {
+                        id: id(i),
+                        context: format!("deviation edge ({u}, {v})"),
+                    });
+                }
+            }
+            if u == v {
+                return Err(CemError::SelfLoop {
+                    kind: "deviation",
+                    u: id(u),
+                });
+            }
+            dev_u.push(u);
+            dev_v.push(v);
+            forces.push(force);
+        }
+
+        // Trails in the order of their supports (Model::new walks from each support in node
+        // order); a support on no trail is a reaction node's one-node trail.
+        let mut given = given;
+        let mut trails = Vec::with_capacity(given.len() + n / 8);
+        for s in (0..n).filter(|&s| supports[s]) {
+            trails.push(match trail_of[s] {
+                usize::MAX => TrailData {
+                    nodes: vec![s],
+                    edges: Vec::new(),
+                    start: 0,
+                },
+                k => {
+                    let nodes = std::mem::take(&mut given[k]);
+                    let edges = (first_edge[k]..first_edge[k] + nodes.len() - 1).collect();
+                    TrailData {
+                        nodes,
+                        edges,
+                        start: 0,
+                    }
+                }
+            });
+        }
+        let is_origin = origins(n, &trails);
+        let shifted = vec![false; trails.len()];
+        let schedule = Schedule::new(&mut trails, &shifted, &supports, &tdeg, &dev_u, &dev_v);
+        let n_input_trail_edges = trail_u.len();
+        Ok(Self {
+            name,
+            ids: (0..n).map(id).collect(),
+            index: IdIndex::identity(n),
+            xyz0: positions,
+            loads,
+            is_support: supports,
+            is_origin,
+            sequence: schedule.sequence,
+            trail_u,
+            trail_v,
+            // No plane-cut edges (an empty list: no per-edge `None` to write for every state).
+            planes: Vec::new(),
+            lengths,
+            dev_u,
+            dev_v,
+            forces,
+            direct: schedule.direct,
+            trails,
+            steps: schedule.steps,
+            adj_start: schedule.adj_start,
+            adj_split: schedule.adj_split,
+            adj: schedule.adj,
+            has_indirect: schedule.has_indirect,
+            aux: Vec::new(),
             n_input_trail_edges,
         })
     }
@@ -456,6 +712,13 @@ impl Model {
     /// Number of nodes including auxiliary nodes.
     pub fn node_count(&self) -> usize {
         self.ids.len()
+    }
+
+    /// The positions the model was built with (topology order, then auxiliary nodes): the
+    /// prescribed ones of origins, starting guesses elsewhere; all of them for a network whose
+    /// geometry is fixed ([`Model::force_pass`]).
+    pub fn initial_positions(&self) -> &[Vector3<f64>] {
+        &self.xyz0
     }
 
     /// Node ids in model order (topology order, then auxiliary nodes).

@@ -280,6 +280,14 @@ impl IdIndex {
         }
     }
 
+    /// Ids `0..n` at indices `0..n` (a network given by index, [`crate::Model::from_trails`]).
+    pub(crate) fn identity(n: usize) -> Self {
+        Self {
+            dense: (0..n).collect(),
+            sparse: HashMap::new(),
+        }
+    }
+
     pub(crate) fn get(&self, id: &NodeId) -> Option<&usize> {
         match usize::try_from(*id).ok().and_then(|k| self.dense.get(k)) {
             Some(i) if *i != usize::MAX => Some(i),

@@ -380,17 +380,17 @@
       scene.remove(lines);
       lines.geometry.dispose();
     }
-    // Plain loops into the typed arrays: this runs on every change, for ~10^4 members.
-    const m = view.members, xyz = view.xyz;
-    const pos = new Float32Array(m.length * 6);
-    const col = new Float32Array(m.length * 6);
+    // Plain loops into the typed arrays: this runs on every change, for ~10^4 members
+    // (`members`: node indices of member k at 2k, 2k + 1; `stress`: its stress).
+    const m = view.members, st = view.stress, xyz = view.xyz;
+    const pos = new Float32Array(st.length * 6);
+    const col = new Float32Array(st.length * 6);
     let scale = 1e-9;
-    for (const e of m) scale = Math.max(scale, Math.abs(e[2]));
-    for (let k = 0; k < m.length; k++) {
-      const e = m[k];
-      const c = colour(e[2], scale);
+    for (let k = 0; k < st.length; k++) scale = Math.max(scale, Math.abs(st[k]));
+    for (let k = 0; k < st.length; k++) {
+      const c = colour(st[k], scale);
       for (let s = 0; s < 2; s++) {
-        const j = 3 * e[s], o = 6 * k + 3 * s;
+        const j = 3 * m[2 * k + s], o = 6 * k + 3 * s;
         pos[o] = xyz[j];
         pos[o + 1] = xyz[j + 1];
         pos[o + 2] = xyz[j + 2];

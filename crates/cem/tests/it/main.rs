@@ -3,6 +3,7 @@
 mod common;
 mod fixed_geometry;
 mod fixtures;
+mod indexed;
 mod optimize;
 mod properties;
 mod validation;

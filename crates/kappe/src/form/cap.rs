@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use crate::form::arch::{Arch, ArchSpec, Catenary, form_find_layer, form_find_layer_with_segments};
 use crate::form::beads::{TriMesh, bead_mesh};
-use crate::form::forces::{Sections2D, StateForces, split_state_forces, state_forces};
+use crate::form::forces::{Sections2D, StateForces, split_state_forces, state_pass};
 use crate::form::frame::LayerFrame;
 use crate::form::overhang::{layer_overhangs, measured_overhangs};
 use crate::form::path::{PrintPath, print_path};
@@ -225,16 +225,19 @@ pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignEr
         context.check()?;
         let state = build_state(&sections, &frame, phi, top)?;
         // A corrugated state is not funicular for its loads: the network carries their
-        // funicular part exactly, the shell the rest (`split_state_forces`).
+        // funicular part exactly, the shell the rest (`split_state_forces`). Only the final
+        // state keeps a topology (`Cap::final_topology`): the others' passes run on the model
+        // built from their trails (`state_pass`).
         let (topology, pass, forces) = if corrugated {
             let (t, p, f, _) = split_state_forces(&state, area)?;
-            (t, p, f)
+            (Some(t), p, f)
         } else {
-            state_forces(&state, area)?
+            let (p, f) = state_pass(&state, area)?;
+            (None, p, f)
         };
         context.step(total);
-        let stresses = (!corrugated)
-            .then(|| StressExtremes::of(&element_stresses_of(&state, &topology, &pass, area)));
+        let stresses =
+            (!corrugated).then(|| StressExtremes::of(element_stresses_of(&state, &pass, area)));
         let summary = StateSummary {
             index: state.index,
             progress: state.progress,
@@ -253,6 +256,11 @@ pub fn design_cap(design: &Design, context: Context<'_>) -> Result<Cap, DesignEr
         .map(|top| solve(top).map(|(_, _, _, summary)| summary))
         .collect::<Result<_, DesignError>>()?;
     let (final_state, final_topology, final_forces, final_summary) = solve(total - 1)?;
+    let final_topology = final_topology.unwrap_or_else(|| {
+        final_state
+            .network
+            .to_topology(&format!("state {}", final_state.index))
+    });
     summaries.push(final_summary);
     let path = print_path(
         &sections,

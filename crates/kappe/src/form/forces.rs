@@ -58,19 +58,30 @@ pub struct Sections2D {
     pub bed_joint: f64,
 }
 
-/// Run the force pass of a state and summarize it.
+/// Run the force pass of a state and summarize it; with the state's CEM topology.
 pub fn state_forces(
     state: &State,
     areas: Sections2D,
 ) -> Result<(Topology, ForcePass, StateForces), DesignError> {
-    let net = &state.network;
-    let topo = net.to_topology(&format!("state {}", state.index));
-    let fp = kappe_cem::fixed_geometry::force_pass(&topo, &net.positions())?;
-    let summary = summarize(state, &topo, &fp, areas);
+    let (fp, summary) = state_pass(state, areas)?;
+    let topo = state.network.to_topology(&format!("state {}", state.index));
     Ok((topo, fp, summary))
 }
 
-fn summarize(state: &State, topo: &Topology, fp: &ForcePass, areas: Sections2D) -> StateForces {
+/// [`state_forces`] without the topology: the force pass over the model built from the
+/// network's trails ([`crate::form::states::Network::to_model`]; the same numbers as the pass
+/// over the topology, without validating again what the construction guarantees).
+pub fn state_pass(
+    state: &State,
+    areas: Sections2D,
+) -> Result<(ForcePass, StateForces), DesignError> {
+    let model = state.network.to_model(&format!("state {}", state.index))?;
+    let fp = model.force_pass(model.initial_positions())?;
+    let summary = summarize(state, &fp, areas);
+    Ok((fp, summary))
+}
+
+fn summarize(state: &State, fp: &ForcePass, areas: Sections2D) -> StateForces {
     let mut cmin: f64 = 0.0;
     let mut cmax: f64 = 0.0;
     let mut smin: f64 = 0.0;
@@ -83,7 +94,8 @@ fn summarize(state: &State, topo: &Topology, fp: &ForcePass, areas: Sections2D) 
         smax = smax.max(f / areas.bed_joint);
         max_abs = max_abs.max(f.abs());
     }
-    for e in &topo.deviation_edges {
+    // The arch segments' forces as the topology's deviation edges carry them.
+    for e in &state.network.deviation_edges {
         let f = e.force;
         cmin = cmin.min(f);
         cmax = cmax.max(f);
@@ -191,7 +203,7 @@ pub fn split_state_forces(
         node.load -= s;
     }
     let fp = kappe_cem::fixed_geometry::force_pass(&topo, &positions)?;
-    let mut summary = summarize(state, &topo, &fp, areas);
+    let mut summary = summarize(state, &fp, areas);
     summary.out_of_funicular = unbalanced.iter().fold(0.0, |m, s| m.max(s.norm()));
     Ok((topo, fp, summary, unbalanced))
 }

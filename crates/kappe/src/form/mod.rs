@@ -22,7 +22,7 @@ pub use cap::{Cap, StateSummary, design_cap};
 // The items users outside the crate need (the CLI, Python, the designer, the tests).
 pub use arch::{Arch, ArchSpec, Catenary, form_find_layer};
 pub use ends::{EndKind, stack_thrust, wall_load};
-pub use forces::{Sections2D, state_forces};
+pub use forces::{Sections2D, state_forces, state_pass};
 pub use frame::{LayerFrame, V3};
 pub use overhang::{layer_overhangs, measured_overhangs};
 pub use section::{NodeKind, Sections, build_sections_with_end};

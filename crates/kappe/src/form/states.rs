@@ -31,6 +31,13 @@ pub enum Role {
     ColumnEnd,
 }
 
+impl Role {
+    /// Feet (reaction nodes) and column ends are the network's supports.
+    pub fn is_support(self) -> bool {
+        matches!(self, Role::Foot | Role::ColumnEnd)
+    }
+}
+
 /// A node of a state network.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NetNode {
@@ -159,15 +166,19 @@ pub fn build_state(
         r_below[q] = r;
     }
 
-    // Nodes, layer by layer, top-down.
-    let mut nodes = Vec::new();
-    let mut deviation_edges = Vec::new();
+    // Nodes, layer by layer, top-down (sized up front: this runs for every state on every
+    // change of a design, and growing the vectors was a tenth of it).
+    let printed = &sections.layers[..=top];
+    let n_layer_nodes: usize = printed.iter().map(|l| l.nodes.len()).sum();
+    let n_segments: usize = printed.iter().map(|l| l.segment_forces.len()).sum();
     // Column ids are the indices of layer 0's nodes; node indices of each column, top-down.
     let n_cols = sections
         .print_index(0)
         .and_then(|q| sections.layers.get(q))
         .map_or(0, |l| l.nodes.len());
-    let mut columns: Vec<Vec<usize>> = vec![Vec::new(); n_cols];
+    let mut nodes = Vec::with_capacity(n_layer_nodes + n_cols);
+    let mut deviation_edges = Vec::with_capacity(n_segments);
+    let mut columns: Vec<Vec<usize>> = (0..n_cols).map(|_| Vec::with_capacity(top + 2)).collect();
     let mut last_layer_of_col: Vec<Option<usize>> = vec![None; n_cols];
     for q in (0..=top).rev() {
         let layer = &sections.layers[q];
@@ -203,7 +214,7 @@ pub fn build_state(
     }
 
     // Column ends on the base plane.
-    let mut trails = Vec::new();
+    let mut trails = Vec::with_capacity(n_cols);
     for (i, col) in columns.iter_mut().enumerate() {
         let (Some(&last), Some(q)) = (col.last(), last_layer_of_col[i]) else {
             continue;
@@ -233,7 +244,7 @@ pub fn build_state(
                 layer: id,
                 role: Role::ColumnEnd,
             });
-            trails.push(col.clone());
+            trails.push(std::mem::take(col));
             continue;
         }
         let dir = if id >= 0 {
@@ -264,7 +275,7 @@ pub fn build_state(
             layer: id,
             role: Role::ColumnEnd,
         });
-        trails.push(col.clone());
+        trails.push(std::mem::take(col));
     }
 
     Ok(State {
@@ -316,18 +327,18 @@ impl Network {
                 id: i as u64,
                 xyz: n.xyz,
                 load: n.load,
-                support: matches!(n.role, Role::Foot | Role::ColumnEnd),
+                support: n.role.is_support(),
                 origin: None,
             })
             .collect();
+        let mut lengths = self.trail_lengths();
         let mut trail_edges = Vec::new();
         for t in &self.trails {
             for w in t.windows(2) {
-                let length = -(self.nodes[w[1]].xyz - self.nodes[w[0]].xyz).norm();
                 trail_edges.push(TrailEdge {
                     u: w[0] as u64,
                     v: w[1] as u64,
-                    length,
+                    length: lengths.next().unwrap_or_default(),
                     plane: None,
                 });
             }
@@ -349,6 +360,40 @@ impl Network {
             auxiliary_trails: None,
             trail_shifts: Vec::new(),
         }
+    }
+
+    /// The CEM model of this network, built from its trails by index
+    /// ([`kappe_cem::Model::from_trails`]): the model [`kappe_cem::Model::new`] builds from
+    /// [`Self::to_topology`], without validating and searching again what `build_state`
+    /// constructed (node ids are the node indices here too). This runs for every print state on
+    /// every change of a design.
+    ///
+    /// # Errors
+    /// A network that breaks the construction's invariants (an internal error).
+    pub fn to_model(&self, name: &str) -> Result<kappe_cem::Model, kappe_cem::CemError> {
+        kappe_cem::Model::from_trails(kappe_cem::IndexedNetwork {
+            name: name.to_string(),
+            positions: self.positions(),
+            loads: self.nodes.iter().map(|n| n.load).collect(),
+            supports: self.nodes.iter().map(|n| n.role.is_support()).collect(),
+            trails: self.trails.clone(),
+            lengths: self.trail_lengths().collect(),
+            deviation_edges: self
+                .deviation_edges
+                .iter()
+                .map(|e| (e.u, e.v, e.force))
+                .collect(),
+        })
+    }
+
+    /// The signed length of every column edge (compression: minus the constructed length),
+    /// trail by trail, top down.
+    fn trail_lengths(&self) -> impl Iterator<Item = f64> + '_ {
+        let at = |i: usize| self.nodes.get(i).map_or_else(V3::zeros, |n| n.xyz);
+        self.trails
+            .iter()
+            .flat_map(|t| t.windows(2))
+            .map(move |w| -(at(w[1]) - at(w[0])).norm())
     }
 
     /// Positions of all nodes, in node order.

@@ -3,14 +3,13 @@
 //! between layers (the column edges), l_trib the tributary length of the column node along its
 //! layer. The forces come from CEM's fixed-geometry force pass ([`crate::form::forces`]).
 
-use std::collections::HashMap;
+use std::borrow::Borrow;
 
 use serde::Serialize;
 
 use kappe_cem::fixed_geometry::ForcePass;
-use kappe_cem::topology::Topology;
 
-use crate::form::forces::{Sections2D, state_forces};
+use crate::form::forces::{Sections2D, state_pass};
 use crate::form::states::{Role, State};
 use crate::input::error::DesignError;
 
@@ -89,32 +88,43 @@ pub fn element_stresses(
     state: &State,
     areas: Sections2D,
 ) -> Result<Vec<ElementStress>, DesignError> {
-    let (topo, fp, _) = state_forces(state, areas)?;
-    Ok(element_stresses_of(state, &topo, &fp, areas))
+    let (fp, _) = state_pass(state, areas)?;
+    Ok(element_stresses_of(state, &fp, areas).collect())
 }
 
-/// [`element_stresses`] of a state whose force pass (`topo`, `fp`) is at hand.
-pub(crate) fn element_stresses_of(
-    state: &State,
-    topo: &Topology,
-    fp: &ForcePass,
+/// [`element_stresses`] of a state whose force pass `fp` is at hand, one by one: arch segments
+/// (the network's deviation edges), then the column edges (its trails' edges top down, the
+/// order of the force pass's trail forces, [`crate::form::states::Network::to_topology`]).
+pub(crate) fn element_stresses_of<'a>(
+    state: &'a State,
+    fp: &'a ForcePass,
     areas: Sections2D,
-) -> Vec<ElementStress> {
+) -> impl Iterator<Item = ElementStress> + 'a {
     let net = &state.network;
-    let mut out = Vec::with_capacity(topo.trail_edges.len() + topo.deviation_edges.len());
-    // Segment index of a node within its layer: nodes of a layer are contiguous, foot first.
-    let mut first_of_layer: HashMap<i32, usize> = HashMap::new();
-    let mut last = None;
+    // Segment index of a node within its layer: nodes of a layer are contiguous, foot first. The
+    // first node of every layer, by layer id (ids run over a short range: a table, no hashing;
+    // this runs for every state of a design).
+    let (low, high) = net.nodes.iter().fold((i32::MAX, i32::MIN), |(lo, hi), n| {
+        (lo.min(n.layer), hi.max(n.layer))
+    });
+    let span = usize::try_from(i64::from(high) - i64::from(low) + 1).unwrap_or(0);
+    let mut first_of_layer = vec![usize::MAX; span];
+    let slot = move |layer: i32| usize::try_from(i64::from(layer) - i64::from(low)).ok();
     for (i, n) in net.nodes.iter().enumerate() {
-        // One map entry per layer, not per node (this runs for every state of a design).
-        if n.role != Role::ColumnEnd && last != Some(n.layer) {
-            first_of_layer.entry(n.layer).or_insert(i);
-            last = Some(n.layer);
+        if n.role != Role::ColumnEnd
+            && let Some(f) = slot(n.layer).and_then(|k| first_of_layer.get_mut(k))
+            && *f == usize::MAX
+        {
+            *f = i;
         }
     }
-    for e in &net.deviation_edges {
-        let first = first_of_layer.get(&e.layer).copied().unwrap_or(e.u);
-        out.push(ElementStress {
+    let segments = net.deviation_edges.iter().map(move |e| {
+        let first = slot(e.layer)
+            .and_then(|k| first_of_layer.get(k))
+            .copied()
+            .filter(|&f| f != usize::MAX)
+            .unwrap_or(e.u);
+        ElementStress {
             kind: ElementKind::ArchSegment {
                 layer: e.layer,
                 segment: e.u.min(e.v).saturating_sub(first),
@@ -123,13 +133,12 @@ pub(crate) fn element_stresses_of(
             force: e.force,
             area: areas.along_layer,
             stress: e.force / areas.along_layer,
-        });
-    }
-    for (edge, &f) in topo.trail_edges.iter().zip(&fp.trail_forces) {
-        let (u, v) = (edge.u as usize, edge.v as usize);
-        let (Some(nu), Some(nv)) = (net.nodes.get(u), net.nodes.get(v)) else {
-            continue;
-        };
+        }
+    });
+    let edges = net.trails.iter().flat_map(|t| t.windows(2));
+    let columns = edges.zip(&fp.trail_forces).filter_map(move |(w, &f)| {
+        let (u, v) = (w[0], w[1]);
+        let (nu, nv) = (net.nodes.get(u)?, net.nodes.get(v)?);
         // A column end above the base plane lies on an end-wall face (`crate::form::ends`).
         let kind = if nv.role == Role::ColumnEnd && nv.xyz.z > 0.0 {
             ElementKind::WallJoint { layer: nu.layer }
@@ -141,15 +150,15 @@ pub(crate) fn element_stresses_of(
                 lower: nu.layer.min(nv.layer),
             }
         };
-        out.push(ElementStress {
+        Some(ElementStress {
             kind,
             nodes: [u, v],
             force: f,
             area: areas.bed_joint,
             stress: f / areas.bed_joint,
-        });
-    }
-    out
+        })
+    });
+    segments.chain(columns)
 }
 
 /// The extremes of one state's element stresses: the first element with the lowest and with the
@@ -166,9 +175,10 @@ pub struct StressExtremes {
 
 impl StressExtremes {
     /// The extremes of `stresses`, in their order.
-    pub fn of(stresses: &[ElementStress]) -> Self {
+    pub fn of<S: Borrow<ElementStress>>(stresses: impl IntoIterator<Item = S>) -> Self {
         let mut e = StressExtremes::default();
         for s in stresses {
+            let s = s.borrow();
             e.add(s.stress, s.kind);
         }
         e

@@ -394,3 +394,28 @@ fn meshes_are_valid_gltf_and_obj() {
     }
     assert!(edges.values().all(|&c| c == 2), "bead mesh is not closed");
 }
+
+/// Every print state's force pass over the model built from its trails (`state_pass`, what
+/// `design_cap` and the designer run on every change) equals, bit for bit, the pass over its CEM
+/// topology validated and built by `kappe_cem::Model::new` (the general entry point), on the
+/// default cap and on an end-wall cap (whose column ends lie on the wall face); and the cap's
+/// summaries come from the same numbers. Exact equality: both build the same schedule and
+/// adjacency (one implementation), so any difference in order would change the rounding.
+#[test]
+fn every_state_pass_equals_the_pass_over_its_topology() {
+    let mut wall = Design::default();
+    wall.cap.end = kappe::form::EndKind::EndWall;
+    for d in [Design::default(), wall] {
+        let cap = design_cap(&d, kappe::Context::default()).unwrap();
+        let areas = cap.areas();
+        for (top, summary) in cap.states.iter().enumerate() {
+            let state = cap.state(top).unwrap();
+            let (fast, forces) = kappe::form::state_pass(&state, areas).unwrap();
+            let topo = state.network.to_topology("state");
+            let general =
+                kappe_cem::fixed_geometry::force_pass(&topo, &state.network.positions()).unwrap();
+            assert_eq!(fast, general, "state {top}");
+            assert_eq!(forces, summary.forces, "state {top}");
+        }
+    }
+}
