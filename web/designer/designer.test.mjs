@@ -40,6 +40,14 @@ test('designer: rise slider, verdict and BLFs equal kappe design, errors, offlin
   const toml = await page.evaluate(() => window.kappeDesigner.designToml());
   assert.match(toml, /rise = 0\.22/);
 
+  // The overhangs coloured on the cap: the legend names the limit (overhang_max, lw/2 = 10 mm
+  // on the default) and the largest layer overhang; back to the stresses.
+  await page.locator('#colour-by').selectOption('overhang');
+  const legend = await page.locator('#legend').textContent();
+  assert.match(legend, /layer overhang: .* limit 10\.0 mm, .* largest \d+\.\d mm/, legend);
+  await page.locator('#colour-by').selectOption('stress');
+  assert.match(await page.locator('#legend').textContent(), /member stress/);
+
   // A bad value typed into a field: an error next to it, the last good design kept.
   const field = page.locator('input[name="cap.rise"]');
   await field.fill('-0.5');

@@ -374,6 +374,12 @@
     const u = Math.max(-1, Math.min(1, stress / scale));
     return u < 0 ? [0.6 + 0.6 * u, 0.6 + 0.2 * u, 0.6 + 0.3 * -u] : [0.6 + 0.4 * u, 0.6 - 0.5 * u, 0.6 - 0.5 * u];
   }
+  // Overhang o against the limit: grey (none) to orange (at the limit), red above it.
+  function overhangColour(o, limit) {
+    if (o > limit) return [0.9, 0.1, 0.1];
+    const u = Math.max(0, Math.min(1, o / Math.max(limit, 1e-12)));
+    return [0.6 + 0.4 * u, 0.6, 0.6 - 0.5 * u];
+  }
   function drawCap(view) {
     if (!renderer) return;
     if (lines) {
@@ -385,10 +391,13 @@
     const m = view.members, st = view.stress, xyz = view.xyz;
     const pos = new Float32Array(st.length * 6);
     const col = new Float32Array(st.length * 6);
+    // Colour by member stress, or by the overhang of the members' layers against the limit.
+    const byOverhang = $('colour-by').value === 'overhang';
+    const oh = view.overhang, ohMax = view.overhang_max;
     let scale = 1e-9;
     for (let k = 0; k < st.length; k++) scale = Math.max(scale, Math.abs(st[k]));
     for (let k = 0; k < st.length; k++) {
-      const c = colour(st[k], scale);
+      const c = byOverhang ? overhangColour(Math.max(oh[m[2 * k]], oh[m[2 * k + 1]]), ohMax) : colour(st[k], scale);
       for (let s = 0; s < 2; s++) {
         const j = 3 * m[2 * k + s], o = 6 * k + 3 * s;
         pos[o] = xyz[j];
@@ -404,7 +413,9 @@
     geo.setAttribute('color', new THREE.BufferAttribute(col, 3));
     lines = new THREE.LineSegments(geo, new THREE.LineBasicMaterial({ vertexColors: true }));
     scene.add(lines);
-    $('legend').textContent = 'member stress: blue compression … red tension, |σ| up to ' + (scale / 1e3).toFixed(2) + ' kPa';
+    $('legend').textContent = byOverhang
+      ? 'layer overhang: grey none … orange at the limit ' + (ohMax * 1e3).toFixed(1) + ' mm, red above it; largest ' + (Math.max(0, ...oh) * 1e3).toFixed(1) + ' mm'
+      : 'member stress: blue compression … red tension, |σ| up to ' + (scale / 1e3).toFixed(2) + ' kPa';
     if (!fitted) {
       geo.computeBoundingSphere();
       const c = geo.boundingSphere.center, r = geo.boundingSphere.radius;
@@ -415,6 +426,8 @@
     }
     render();
   }
+
+  $('colour-by').addEventListener('change', () => current && drawCap(current.view));
 
   // ---- files ----------------------------------------------------------------------------------
   $('download').addEventListener('click', () => {

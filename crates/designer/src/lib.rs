@@ -578,7 +578,32 @@ fn view(cap: &Cap) -> Value {
         members.extend(e.nodes);
         stress.push(on_grid(e.stress, 10.0));
     }
-    json!({ "xyz": xyz, "members": members, "stress": stress, "overhangs": cap.overhangs })
+    // Each node's layer overhang (`Cap::overhangs`, in print order) for the overhang colouring,
+    // and the limit it is judged against.
+    let print_index: HashMap<i32, usize> = cap
+        .sections
+        .layers
+        .iter()
+        .enumerate()
+        .map(|(k, l)| (l.id, k))
+        .collect();
+    let overhang: Vec<f64> = net
+        .nodes
+        .iter()
+        .map(|n| {
+            print_index
+                .get(&n.layer)
+                .and_then(|&k| cap.overhangs.get(k))
+                .map_or(0.0, |&o| on_grid(o, 1e4))
+        })
+        .collect();
+    json!({
+        "xyz": xyz,
+        "members": members,
+        "stress": stress,
+        "overhang": overhang,
+        "overhang_max": cap.design.overhang_max(),
+    })
 }
 
 /// A Web Worker's share of the buckling analysis: the cap of the design it was given, the warm

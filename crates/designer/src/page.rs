@@ -50,7 +50,9 @@ pub fn page(glue: &str, wasm_gz: &[u8]) -> String {
 <span class=\"small\">(or drop it on the page)</span></header>\n\
 <main>\n<section id=\"fields\" aria-label=\"design parameters\"><div id=\"error-design\" class=\"error\"></div></section>\n\
 <section>\n<canvas id=\"kappe-canvas\" aria-label=\"3D view of the cap\"></canvas>\
-<div id=\"viewer-message\" class=\"error\"></div><p id=\"legend\" class=\"small\"></p>\n\
+<div id=\"viewer-message\" class=\"error\"></div><p class=\"small\"><label>colour by \
+<select id=\"colour-by\"><option value=\"stress\">member stress</option>\
+<option value=\"overhang\">layer overhang</option></select></label> <span id=\"legend\"></span></p>\n\
 <h2>Constraints</h2>\n<table id=\"constraints\"><thead><tr><th>constraint</th><th></th><th>limit</th>\
 <th>worst</th><th>state</th><th>where</th></tr></thead><tbody></tbody></table>\n<p id=\"failures\"></p>\n\
 <h2>Every print state</h2><div id=\"plot\"></div>\n\
