@@ -269,13 +269,35 @@ fn after_form(
         Some(g) => (Some(g.fe), Some(g.refined), g.increments),
         None => (None, None, Default::default()),
     };
+    let analysis = match &options.analysis {
+        Some(o) => Some(crate::analysis::analyze(
+            &cap,
+            o,
+            crate::analysis::Request {
+                schedule: Some(&schedule),
+                fe: given_fe,
+                refined,
+                context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
+            },
+        )?),
+        None => None,
+    };
+    check(stop)?;
+    // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.
+    let mut reliability = match &analysis {
+        Some(a) => crate::analysis::reliability::reliability(&cap, a, &schedule)?,
+        None => None,
+    };
+    // `[uncertainty] monte_carlo = N`: the print's governing states sampled (issue 24).
+    if let (Some(r), Some(a)) = (reliability.as_mut(), &analysis) {
+        r.monte_carlo =
+            crate::analysis::design_monte_carlo::design_monte_carlo(&cap, a, &schedule, r)?;
+    }
+    check(stop)?;
     // A relocated base is never exactly where planned (issue 15): re-check the plan under the
     // base-pose errors of `[robot.tolerance]`; with `verdict = true` a failure fails the design.
-    // The check reads the plan alone, so it runs beside the analysis: both are parallel, and
-    // together they keep the two cores busier than one after the other (the analysis's last
-    // solves leave a core idle).
     let tol = &cap.design.robot.tolerance;
-    let base_tolerance = || match (&robot, &moving) {
+    let base_tolerance = match (&robot, &moving) {
         (Some(Ok(_)), Some(m)) if tol.check => Some(kappe_robot::check_moving_tolerance(
             &m.plan,
             &tol.base_tolerance(),
@@ -289,6 +311,7 @@ fn after_form(
         }
         _ => None,
     };
+<<<<<<< HEAD
     let analysis = || -> Result<Option<Analysis>, DesignError> {
         Ok(match &options.analysis {
             Some(o) => Some(crate::analysis::analyze(
@@ -319,6 +342,8 @@ fn after_form(
             crate::analysis::design_monte_carlo::design_monte_carlo(&cap, a, &schedule, r)?;
     }
     check(stop)?;
+=======
+>>>>>>> parent of 4098575 (kappe design: the plan's base-tolerance check runs beside the analysis (rayon::join; it reads the plan alone), instead of after it; the same outputs bit for bit (summary.json, plan.json, programs.json, trajectory.csv))
     let mut verdict = crate::verdict::verdict(
         &cap,
         analysis.as_ref(),
