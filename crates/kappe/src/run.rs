@@ -277,6 +277,7 @@ fn after_form(
                 schedule: Some(&schedule),
                 fe: given_fe,
                 refined,
+                increments,
                 context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
             },
         )?),
@@ -311,39 +312,6 @@ fn after_form(
         }
         _ => None,
     };
-<<<<<<< HEAD
-    let analysis = || -> Result<Option<Analysis>, DesignError> {
-        Ok(match &options.analysis {
-            Some(o) => Some(crate::analysis::analyze(
-                &cap,
-                o,
-                crate::analysis::Request {
-                    schedule: Some(&schedule),
-                    fe: given_fe,
-                    refined,
-                    increments,
-                    context: crate::input::context::Context::new(&|total| fe.tick(total), stop),
-                },
-            )?),
-            None => None,
-        })
-    };
-    let (base_tolerance, analysis) = rayon::join(base_tolerance, analysis);
-    let analysis = analysis?;
-    check(stop)?;
-    // Reliability under `[uncertainty]` (issue 24): None without the table, so nothing changes.
-    let mut reliability = match &analysis {
-        Some(a) => crate::analysis::reliability::reliability(&cap, a, &schedule)?,
-        None => None,
-    };
-    // `[uncertainty] monte_carlo = N`: the print's governing states sampled (issue 24).
-    if let (Some(r), Some(a)) = (reliability.as_mut(), &analysis) {
-        r.monte_carlo =
-            crate::analysis::design_monte_carlo::design_monte_carlo(&cap, a, &schedule, r)?;
-    }
-    check(stop)?;
-=======
->>>>>>> parent of 4098575 (kappe design: the plan's base-tolerance check runs beside the analysis (rayon::join; it reads the plan alone), instead of after it; the same outputs bit for bit (summary.json, plan.json, programs.json, trajectory.csv))
     let mut verdict = crate::verdict::verdict(
         &cap,
         analysis.as_ref(),
