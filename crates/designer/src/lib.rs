@@ -580,20 +580,13 @@ fn view(cap: &Cap) -> Value {
     }
     // Each node's layer overhang (`Cap::overhangs`, in print order) for the overhang colouring,
     // and the limit it is judged against.
-    let print_index: HashMap<i32, usize> = cap
-        .sections
-        .layers
-        .iter()
-        .enumerate()
-        .map(|(k, l)| (l.id, k))
-        .collect();
     let overhang: Vec<f64> = net
         .nodes
         .iter()
         .map(|n| {
-            print_index
-                .get(&n.layer)
-                .and_then(|&k| cap.overhangs.get(k))
+            cap.sections
+                .print_index(n.layer)
+                .and_then(|k| cap.overhangs.get(k))
                 .map_or(0.0, |&o| on_grid(o, 1e4))
         })
         .collect();
