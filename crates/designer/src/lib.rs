@@ -401,13 +401,8 @@ impl SessionCore {
             .map_err(|e| FieldError::of(&e))?;
         let runs = fe_runs(&design.analysis, cap.states.len());
         // The quick pass must succeed before the design is taken (e.g. a bad [schedule]).
-        let outcome = evaluate(
-            &cap,
-            &BTreeMap::new(),
-            &RefineSolves::new(),
-            &HashMap::new(),
-        )
-        .map_err(|e| FieldError::of(&e))?;
+        let outcome = evaluate(&cap, &BTreeMap::new(), &RefineSolves::new(), HashMap::new())
+            .map_err(|e| FieldError::of(&e))?;
         self.text = text.to_string();
         self.runs = runs;
         self.fe.clear();
@@ -465,8 +460,16 @@ impl SessionCore {
                 }
             }
         }
-        let outcome = evaluate(cap, &self.fe, &self.refined, &self.printed)
-            .map_err(|e| FieldError::of(&e))?;
+        // The increments are used only once every state is in (the as-printed pass runs on a
+        // complete analysis), so they are cloned only then.
+        let all_in = self.fe.len() >= self.runs.iter().map(Vec::len).sum::<usize>();
+        let printed = if all_in {
+            self.printed.clone()
+        } else {
+            HashMap::new()
+        };
+        let outcome =
+            evaluate(cap, &self.fe, &self.refined, printed).map_err(|e| FieldError::of(&e))?;
         Ok(report(&outcome, &self.runs))
     }
 }
@@ -478,7 +481,7 @@ fn evaluate(
     cap: &Cap,
     fe: &BTreeMap<usize, StateFe>,
     refined: &RefineSolves,
-    printed: &HashMap<usize, Increment>,
+    printed: HashMap<usize, Increment>,
 ) -> Result<kappe::Outcome, DesignError> {
     let options = kappe::Options {
         analysis: Some(cap.design.analysis.clone()),
@@ -491,18 +494,7 @@ fn evaluate(
         Some(kappe::Given {
             fe: fe.values().cloned().collect(),
             refined: refined.clone(),
-            // Used only once every state is in (the as-printed pass runs on a complete
-            // analysis), so cloned only then.
-            increments: if fe.len()
-                >= fe_runs(&cap.design.analysis, cap.states.len())
-                    .iter()
-                    .map(Vec::len)
-                    .sum()
-            {
-                printed.clone()
-            } else {
-                HashMap::new()
-            },
+            increments: printed,
         }),
         &kappe::no_progress,
     )
@@ -554,7 +546,8 @@ fn report(outcome: &kappe::Outcome, runs: &[Vec<usize>]) -> Value {
 }
 
 /// The cap for the 3D view: the final state's network (node positions) and its members with
-/// their stress ([`kappe::analysis::element_stresses`]), and the overhang of every layer.
+/// their stress ([`kappe::analysis::element_stresses`]), each node's layer overhang and the
+/// limit `overhang_max`.
 ///
 /// Flat arrays (`members`: the two node indices of member k at 2k and 2k + 1; `stress`: its
 /// stress): the page reads nothing else of the view, and one JSON number per entry instead of a

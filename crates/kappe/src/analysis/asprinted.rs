@@ -25,7 +25,6 @@ use crate::analysis::buckling::state_material;
 use crate::analysis::graded::AnalysedState;
 use crate::analysis::shell::{NoShell, StateShell, state_shell};
 use crate::form::cap::Cap;
-use crate::form::states::Role;
 use crate::input::analysis::AnalysisOptions;
 use crate::input::error::DesignError;
 
@@ -241,10 +240,20 @@ pub fn cap_increment(
         state: top,
         message: format!("as-printed increment failed: {e}"),
     })?;
-    Ok(match analysed {
-        AnalysedState::Graded(..) => fill_graded(&state, &inc),
+    Ok(on_state(&state, &analysed, inc))
+}
+
+/// An increment solved on the shell of `analysed` as one on every node of `state`: itself on
+/// the state's own mesh, filled in over the dropped nodes ([`fill_graded`]) on a graded one.
+pub fn on_state(
+    state: &crate::form::states::State,
+    analysed: &AnalysedState<'_>,
+    inc: Increment,
+) -> Increment {
+    match analysed {
+        AnalysedState::Graded(..) => fill_graded(state, &inc),
         AnalysedState::Full(_) => inc,
-    })
+    }
 }
 
 /// The key of every node of a state's shell (None: a node not tracked, e.g. a column end).
@@ -259,20 +268,14 @@ pub fn node_keys_of(
     analysed: &AnalysedState<'_>,
     shell: &StateShell,
 ) -> Vec<Option<NodeKey>> {
-    // First network index of every layer: the network stores each layer contiguously.
-    let mut first: HashMap<i32, usize> = HashMap::new();
-    for (i, n) in state.network.nodes.iter().enumerate() {
-        if n.role != Role::ColumnEnd {
-            first.entry(n.layer).or_insert(i);
-        }
-    }
+    let starts = state.network.layer_starts();
     shell
         .network_node
         .iter()
         .map(|&k| {
             let i = analysed.full_index(k)?;
             let layer = state.network.nodes.get(i)?.layer;
-            Some((layer, i.checked_sub(*first.get(&layer)?)?))
+            Some((layer, i.checked_sub(starts.get(layer)?)?))
         })
         .collect()
 }
@@ -285,21 +288,16 @@ pub fn node_keys_of(
 /// top row are always kept, and every kept row keeps both feet, so every dropped node lies
 /// between kept ones. The increment's field is smooth with depth where the grading thins it
 /// (the newest `fine` layers, where the new weight acts, are all rows), the premise of the
-/// graded buckling mesh; docs/as-printed.md §5 measures what the filling costs in accuracy.
+/// graded buckling mesh; docs/as-printed.md §6 measures what the filling costs in accuracy.
 pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Increment {
     let known: HashMap<NodeKey, [f64; 3]> = inc.nodes.iter().map(|(k, _, d)| (*k, *d)).collect();
     let net = &state.network;
-    let mut first: HashMap<i32, usize> = HashMap::new();
-    for (i, n) in net.nodes.iter().enumerate() {
-        if n.role != Role::ColumnEnd {
-            first.entry(n.layer).or_insert(i);
-        }
-    }
+    let starts = net.layer_starts();
     // Every row bottom-up: its nodes' keys and design positions.
     let rows: Vec<Vec<(NodeKey, [f64; 3])>> = crate::analysis::shell::layer_rows(net)
         .into_iter()
         .map(|(layer, nodes)| {
-            let f = first.get(&layer).copied().unwrap_or(0);
+            let f = starts.get(layer).unwrap_or(0);
             nodes
                 .into_iter()
                 .filter_map(|i| {
@@ -309,35 +307,18 @@ pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Incre
                 .collect()
         })
         .collect();
-    // Along each row that kept any node.
+    // Along each row that kept any node: every node's value, the dropped ones interpolated.
     let along: Vec<Option<Vec<[f64; 3]>>> = rows
         .iter()
         .map(|row| {
             let vals: Vec<Option<[f64; 3]>> =
                 row.iter().map(|(k, _)| known.get(k).copied()).collect();
             let kept: Vec<usize> = (0..vals.len()).filter(|&j| vals[j].is_some()).collect();
-            if kept.is_empty() {
-                return None;
-            }
-            Some(
+            (!kept.is_empty()).then(|| {
                 (0..vals.len())
-                    .map(|j| {
-                        if let Some(v) = vals[j] {
-                            return v;
-                        }
-                        let b = kept.partition_point(|&k| k < j);
-                        match (b.checked_sub(1).map(|a| kept[a]), kept.get(b)) {
-                            (Some(a), Some(&c)) => {
-                                let w = (j - a) as f64 / (c - a) as f64;
-                                lerp(vals[a], vals[c], w)
-                            }
-                            (Some(a), None) => vals[a].unwrap_or_default(),
-                            (None, Some(&c)) => vals[c].unwrap_or_default(),
-                            (None, None) => [0.0; 3],
-                        }
-                    })
-                    .collect(),
-            )
+                    .map(|j| between(&kept, j, |a| vals[a].unwrap_or_default()))
+                    .collect()
+            })
         })
         .collect();
     let kept_rows: Vec<usize> = (0..rows.len()).filter(|&q| along[q].is_some()).collect();
@@ -351,7 +332,7 @@ pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Incre
         }
         let p = t * (v.len() - 1) as f64;
         let a = (p.floor() as usize).min(v.len() - 2);
-        lerp(Some(v[a]), Some(v[a + 1]), p - a as f64)
+        lerp(v[a], v[a + 1], p - a as f64)
     };
     let mut nodes = Vec::with_capacity(rows.iter().map(Vec::len).sum());
     for (q, row) in rows.iter().enumerate() {
@@ -365,16 +346,7 @@ pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Incre
                     } else {
                         0.0
                     };
-                    let b = kept_rows.partition_point(|&k| k < q);
-                    match (b.checked_sub(1).map(|a| kept_rows[a]), kept_rows.get(b)) {
-                        (Some(a), Some(&c)) => {
-                            let w = (q - a) as f64 / (c - a) as f64;
-                            lerp(Some(at(a, t)), Some(at(c, t)), w)
-                        }
-                        (Some(a), None) => at(a, t),
-                        (None, Some(&c)) => at(c, t),
-                        (None, None) => [0.0; 3],
-                    }
+                    between(&kept_rows, q, |a| at(a, t))
                 }
             };
             nodes.push((*key, *x, du));
@@ -386,9 +358,22 @@ pub fn fill_graded(state: &crate::form::states::State, inc: &Increment) -> Incre
     }
 }
 
+/// The value at position `j` of a sequence known at the sorted positions `kept` (`value(a)` for
+/// `a` in `kept`): itself where kept, else linear between the kept neighbours on either side (the
+/// nearest one where only one side has any).
+fn between(kept: &[usize], j: usize, value: impl Fn(usize) -> [f64; 3]) -> [f64; 3] {
+    let b = kept.partition_point(|&k| k < j);
+    match (b.checked_sub(1).map(|a| kept[a]), kept.get(b)) {
+        (_, Some(&c)) if c == j => value(c),
+        (Some(a), Some(&c)) => lerp(value(a), value(c), (j - a) as f64 / (c - a) as f64),
+        (Some(a), None) => value(a),
+        (None, Some(&c)) => value(c),
+        (None, None) => [0.0; 3],
+    }
+}
+
 /// (1 − w)·a + w·b.
-fn lerp(a: Option<[f64; 3]>, b: Option<[f64; 3]>, w: f64) -> [f64; 3] {
-    let (a, b) = (a.unwrap_or_default(), b.unwrap_or_default());
+fn lerp(a: [f64; 3], b: [f64; 3], w: f64) -> [f64; 3] {
     [0, 1, 2].map(|c| (1.0 - w) * a[c] + w * b[c])
 }
 
@@ -479,12 +464,8 @@ mod tests {
         };
         // Keys of the reduced network's nodes, each with the field at its full node.
         let (_, map) = crate::analysis::graded::graded_state_map(&state, &g);
-        let mut first: HashMap<i32, usize> = HashMap::new();
-        for (i, n) in state.network.nodes.iter().enumerate() {
-            if n.role != Role::ColumnEnd {
-                first.entry(n.layer).or_insert(i);
-            }
-        }
+        let starts = state.network.layer_starts();
+        let first = |layer: i32| starts.get(layer).expect("layer");
         let mut at: HashMap<usize, (usize, usize, usize)> = HashMap::new();
         for (q, (_, nodes)) in rows.iter().enumerate() {
             for (j, &i) in nodes.iter().enumerate() {
@@ -496,7 +477,7 @@ mod tests {
             .map(|&i| {
                 let n = &state.network.nodes[i];
                 let (q, j, m) = at[&i];
-                ((n.layer, i - first[&n.layer]), [0.0; 3], field(q, j, m))
+                ((n.layer, i - first(n.layer)), [0.0; 3], field(q, j, m))
             })
             .collect();
         let total: usize = rows.iter().map(|r| r.1.len()).sum();
@@ -511,7 +492,7 @@ mod tests {
         assert_eq!(filled.nodes.len(), total);
         for (q, (layer, nodes)) in rows.iter().enumerate() {
             for (j, &i) in nodes.iter().enumerate() {
-                let key = (*layer, i - first[layer]);
+                let key = (*layer, i - first(*layer));
                 let got = filled
                     .nodes
                     .iter()

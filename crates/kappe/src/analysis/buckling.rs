@@ -215,12 +215,7 @@ pub fn state_buckling(
     let mut solved = solved.into_iter();
     let increment = printed.then(|| solved.next()).flatten().map(|r| {
         let inc = crate::analysis::asprinted::increment_of(&shell.model.nodes, &keys, &r);
-        match &analysed {
-            crate::analysis::graded::AnalysedState::Graded(..) => {
-                crate::analysis::asprinted::fill_graded(state, &inc)
-            }
-            crate::analysis::graded::AnalysedState::Full(_) => inc,
-        }
+        crate::analysis::asprinted::on_state(state, &analysed, inc)
     });
     let stresses = match (unbalanced, bending_case, solved.next()) {
         (Some(u), Some(case), Some(st)) => Some(u.stresses(state, &shell, &case, &st)),
@@ -448,8 +443,9 @@ pub fn mode_on_shell(state: &State, shell: &StateShell, mode: &ModeGuess) -> Opt
         .collect()
 }
 
-/// A start vector per shell node (`keys`: [`crate::analysis::asprinted::node_keys_of`]) from the mode `g`: a layer missing
-/// from `g` takes the nearest layer below it, a node without a key zero.
+/// A start vector per shell node (`keys`: [`crate::analysis::asprinted::node_keys_of`]) from
+/// the mode `g`: a layer missing from `g` takes the nearest layer below it, a node without a key
+/// zero.
 fn guess_start(keys: &[Option<(i32, usize)>], g: &ModeGuess) -> Vec<[f64; 6]> {
     keys.iter()
         .map(|key| {

@@ -64,6 +64,27 @@ pub struct DevEdge {
     pub layer: i32,
 }
 
+/// [`Network::layer_starts`]: the first network index of every layer, by layer id.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerStarts {
+    low: i32,
+    first: Vec<usize>,
+}
+
+impl LayerStarts {
+    fn slot(&self, layer: i32) -> Option<usize> {
+        usize::try_from(i64::from(layer) - i64::from(self.low)).ok()
+    }
+
+    /// The network index of layer `layer`'s first node (`None`: no such layer).
+    pub fn get(&self, layer: i32) -> Option<usize> {
+        self.slot(layer)
+            .and_then(|k| self.first.get(k))
+            .copied()
+            .filter(|&f| f != usize::MAX)
+    }
+}
+
 /// The CEM network of one print state, with constructed geometry.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Network {
@@ -394,6 +415,30 @@ impl Network {
             .iter()
             .flat_map(|t| t.windows(2))
             .map(move |w| -(at(w[1]) - at(w[0])).norm())
+    }
+
+    /// The network index of every layer's first node (each layer is stored contiguously, foot
+    /// first; column ends are not layer nodes), by layer id: so a node's index within its layer
+    /// is its network index less its layer's start. A table over the short range of layer ids,
+    /// no hashing: it is read for every print state on every change of a design.
+    pub fn layer_starts(&self) -> LayerStarts {
+        let (low, high) = self.nodes.iter().fold((i32::MAX, i32::MIN), |(lo, hi), n| {
+            (lo.min(n.layer), hi.max(n.layer))
+        });
+        let span = usize::try_from(i64::from(high) - i64::from(low) + 1).unwrap_or(0);
+        let mut starts = LayerStarts {
+            low,
+            first: vec![usize::MAX; span],
+        };
+        for (i, n) in self.nodes.iter().enumerate() {
+            if n.role != Role::ColumnEnd
+                && let Some(f) = starts.slot(n.layer).and_then(|k| starts.first.get_mut(k))
+                && *f == usize::MAX
+            {
+                *f = i;
+            }
+        }
+        starts
     }
 
     /// Positions of all nodes, in node order.

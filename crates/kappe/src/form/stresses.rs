@@ -101,29 +101,10 @@ pub(crate) fn element_stresses_of<'a>(
     areas: Sections2D,
 ) -> impl Iterator<Item = ElementStress> + 'a {
     let net = &state.network;
-    // Segment index of a node within its layer: nodes of a layer are contiguous, foot first. The
-    // first node of every layer, by layer id (ids run over a short range: a table, no hashing;
-    // this runs for every state of a design).
-    let (low, high) = net.nodes.iter().fold((i32::MAX, i32::MIN), |(lo, hi), n| {
-        (lo.min(n.layer), hi.max(n.layer))
-    });
-    let span = usize::try_from(i64::from(high) - i64::from(low) + 1).unwrap_or(0);
-    let mut first_of_layer = vec![usize::MAX; span];
-    let slot = move |layer: i32| usize::try_from(i64::from(layer) - i64::from(low)).ok();
-    for (i, n) in net.nodes.iter().enumerate() {
-        if n.role != Role::ColumnEnd
-            && let Some(f) = slot(n.layer).and_then(|k| first_of_layer.get_mut(k))
-            && *f == usize::MAX
-        {
-            *f = i;
-        }
-    }
+    // Segment index of a node within its layer: nodes of a layer are contiguous, foot first.
+    let starts = net.layer_starts();
     let segments = net.deviation_edges.iter().map(move |e| {
-        let first = slot(e.layer)
-            .and_then(|k| first_of_layer.get(k))
-            .copied()
-            .filter(|&f| f != usize::MAX)
-            .unwrap_or(e.u);
+        let first = starts.get(e.layer).unwrap_or(e.u);
         ElementStress {
             kind: ElementKind::ArchSegment {
                 layer: e.layer,
