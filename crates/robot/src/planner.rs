@@ -20,6 +20,20 @@ use crate::ladder::{LadderFailure, LadderPath, solve_optimal, solve_random};
 use crate::plan::{CLEARANCE_CUTOFF, LayerPlan, Plan, PlanMark, Station, Waypoint};
 use crate::setup::{BasePlacement, PlanOptions, PlannerKind, PrintLayer, RobotSetup};
 
+/// The elbow/wrist branch of a configuration: the signs of sin q3 and sin q5. A re-solve of a
+/// planned target (base-tolerance checks) must stay on the planned one.
+pub fn branch(q: &Joints) -> (bool, bool) {
+    (q[2].sin() > 0.0, q[4].sin() > 0.0)
+}
+
+/// Which valid vertices [`Context::vertices_upto`] collects: at most `max`, and only those on
+/// `branch` when given.
+#[derive(Clone, Copy)]
+struct Select {
+    max: usize,
+    branch: Option<(bool, bool)>,
+}
+
 /// Geometry shared by all stations: models, static scene, tool.
 pub(crate) struct Context {
     pub self_model: RobotModel,
@@ -359,7 +373,36 @@ impl Context {
             world_from_base,
             world_tcp,
             order,
-            usize::MAX,
+            Select {
+                max: usize::MAX,
+                branch: None,
+            },
+        )
+    }
+
+    /// [`Self::vertices`] restricted to the elbow/wrist branch `branch` ([`branch`]): the
+    /// configurations of the other branches are not checked at all (nor counted in the
+    /// rejections). The base-tolerance checks take only the planned branch, so they measure
+    /// the clearances of two IK solutions per target instead of eight.
+    pub fn vertices_on_branch(
+        &self,
+        scene: &Scene,
+        base_from_world: &Iso,
+        world_from_base: &Iso,
+        world_tcp: &Iso,
+        order: usize,
+        branch: (bool, bool),
+    ) -> (Vec<Vertex>, Rejections) {
+        self.vertices_upto(
+            scene,
+            base_from_world,
+            world_from_base,
+            world_tcp,
+            order,
+            Select {
+                max: usize::MAX,
+                branch: Some(branch),
+            },
         )
     }
 
@@ -376,12 +419,22 @@ impl Context {
         order: usize,
     ) -> bool {
         !self
-            .vertices_upto(scene, base_from_world, world_from_base, world_tcp, order, 1)
+            .vertices_upto(
+                scene,
+                base_from_world,
+                world_from_base,
+                world_tcp,
+                order,
+                Select {
+                    max: 1,
+                    branch: None,
+                },
+            )
             .0
             .is_empty()
     }
 
-    /// The valid vertices, at most `max` of them; with `max < usize::MAX` clearances are
+    /// The valid vertices as `select` asks; with `max < usize::MAX` clearances are
     /// measured only up to the required clearance (see [`Self::has_vertex`]).
     fn vertices_upto(
         &self,
@@ -390,7 +443,10 @@ impl Context {
         world_from_base: &Iso,
         world_tcp: &Iso,
         order: usize,
-        max: usize,
+        Select {
+            max,
+            branch: on_branch,
+        }: Select,
     ) -> (Vec<Vertex>, Rejections) {
         let cutoff = if max == usize::MAX {
             CLEARANCE_CUTOFF
@@ -410,6 +466,9 @@ impl Context {
             let base_flange = base_tcp.mul(&self.tcp_from_flange);
             let sols = UR10E.ik(&base_flange);
             for q0 in sols.as_slice() {
+                if on_branch.is_some_and(|b| branch(q0) != b) {
+                    continue;
+                }
                 rej.ik += 1;
                 let mut q = *q0;
                 if self.coaxial {

@@ -388,7 +388,8 @@ pub fn check_moving_tolerance(
                     continue;
                 }
                 n += 1;
-                let (verts, rej) = geo.vertices(&off(k), li, k);
+                let (verts, rej) =
+                    geo.vertices_where(&off(k), li, k, Some(crate::planner::branch(&w.q)));
                 let point = format!("{at}: point {}", w.index);
                 resolver.next(&w.q, &verts, &rej, &point, &mut min_c, &mut pr);
             }

@@ -473,8 +473,25 @@ impl Geometry {
 
     /// Valid vertices of target (o, k) from base pose `w`.
     fn vertices(&self, w: &Iso, o: usize, k: usize) -> (Vec<Vertex>, Rejections) {
+        self.vertices_where(w, o, k, None)
+    }
+
+    /// [`Self::vertices`], only those on elbow/wrist branch `on_branch` when given
+    /// ([`crate::planner::Context::vertices_on_branch`]).
+    fn vertices_where(
+        &self,
+        w: &Iso,
+        o: usize,
+        k: usize,
+        on_branch: Option<(bool, bool)>,
+    ) -> (Vec<Vertex>, Rejections) {
         let frame = self.world.target_frame(&self.world.layers[o], k);
-        let (mut v, mut rej) = self.world.vertices(&self.scene, &w.inverse(), w, &frame, o);
+        let (mut v, mut rej) = match on_branch {
+            None => self.world.vertices(&self.scene, &w.inverse(), w, &frame, o),
+            Some(b) => self
+                .world
+                .vertices_on_branch(&self.scene, &w.inverse(), w, &frame, o, b),
+        };
         let need = self.world.opts.clearance;
         v.retain_mut(|x| {
             let c = self.body_clearance(&x.q, CLEARANCE_CUTOFF);
