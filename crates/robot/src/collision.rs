@@ -361,14 +361,23 @@ struct SceneShape {
 
 /// Capsule chain segments, chunked with bounding boxes, tagged by layer. Chunks are grouped
 /// (consecutive chunks, `GROUP` at a time) under a second level of boxes with the group's
-/// smallest layer tag, so that a query skips whole groups that are far or not yet printed: a
-/// two-level bounding-volume hierarchy. Both levels are lower bounds, so the result is exact.
+/// smallest layer tag, and groups (`SUPER` at a time) under a third, so that a query skips whole
+/// groups that are far or not yet printed: a three-level bounding-volume hierarchy over the
+/// print order (consecutive bead is near in space). Every level is a lower bound, so the result
+/// is exact; and a level only skips what the level below would skip at the same bound, so the
+/// segments measured, and every result, are the same as with two levels. The third level is for
+/// long prints: a 1.5 m × 4 m bay has ~1,000 groups, which every query scanned.
 #[derive(Clone, Debug, Default)]
 pub struct SegmentSoup {
     segs: Vec<(DVec3, DVec3, f64)>,
     chunks: Vec<Chunk>,
     groups: Vec<Group>,
+    /// Boxes over `SUPER` consecutive groups (`start..end` index `groups`).
+    supers: Vec<Group>,
 }
+
+/// Groups per super-group (≈ 770 segments, ≈ 15 m of bead).
+const SUPER: usize = 16;
 
 #[derive(Clone, Debug)]
 struct Group {
@@ -425,21 +434,9 @@ impl SegmentSoup {
                 hi,
             });
             let ci = self.chunks.len() - 1;
-            match self.groups.last_mut() {
-                Some(g) if g.end - g.start < GROUP => {
-                    g.end = ci + 1;
-                    g.min_layer = g.min_layer.min(layer);
-                    g.lo = g.lo.min(lo);
-                    g.hi = g.hi.max(hi);
-                }
-                _ => self.groups.push(Group {
-                    min_layer: layer,
-                    start: ci,
-                    end: ci + 1,
-                    lo,
-                    hi,
-                }),
-            }
+            push_into(&mut self.groups, GROUP, ci, layer, lo, hi);
+            let gi = self.groups.len() - 1;
+            push_into(&mut self.supers, SUPER, gi, layer, lo, hi);
         }
     }
 
@@ -453,9 +450,13 @@ impl SegmentSoup {
         below_layer: usize,
         lim: &'a std::cell::Cell<f64>,
     ) -> impl Iterator<Item = &'a Chunk> + 'a {
-        self.groups
+        let near =
+            move |g: &&Group| g.min_layer < below_layer && box_gap(lo, hi, g.lo, g.hi) <= lim.get();
+        self.supers
             .iter()
-            .filter(move |g| g.min_layer < below_layer && box_gap(lo, hi, g.lo, g.hi) <= lim.get())
+            .filter(near)
+            .flat_map(move |s| &self.groups[s.start..s.end])
+            .filter(near)
             .flat_map(move |g| &self.chunks[g.start..g.end])
             .filter(move |ch| ch.layer < below_layer && box_gap(lo, hi, ch.lo, ch.hi) <= lim.get())
     }
@@ -487,6 +488,26 @@ impl SegmentSoup {
             }
         }
         best
+    }
+}
+
+/// Add item `i` (tag `layer`, box `lo`–`hi`) to the last box of `level` if it holds fewer than
+/// `per` items or already holds `i` (the last group, grown by a chunk), else to a new box.
+fn push_into(level: &mut Vec<Group>, per: usize, i: usize, layer: usize, lo: DVec3, hi: DVec3) {
+    match level.last_mut() {
+        Some(g) if g.end > i || g.end - g.start < per => {
+            g.end = g.end.max(i + 1);
+            g.min_layer = g.min_layer.min(layer);
+            g.lo = g.lo.min(lo);
+            g.hi = g.hi.max(hi);
+        }
+        _ => level.push(Group {
+            min_layer: layer,
+            start: i,
+            end: i + 1,
+            lo,
+            hi,
+        }),
     }
 }
 
