@@ -26,12 +26,15 @@ pub fn branch(q: &Joints) -> (bool, bool) {
     (q[2].sin() > 0.0, q[4].sin() > 0.0)
 }
 
-/// Which valid vertices [`Context::vertices_upto`] collects: at most `max`, and only those on
-/// `branch` when given.
+/// Which valid vertices [`Context::vertices_upto`] collects (at most `max`, and only those on
+/// `branch` when given) and how far their clearances are measured.
 #[derive(Clone, Copy)]
 struct Select {
     max: usize,
     branch: Option<(bool, bool)>,
+    /// Clearances at or above this are reported as it (a valid vertex needs a cutoff of at
+    /// least the required clearance).
+    cutoff: f64,
 }
 
 /// Geometry shared by all stations: models, static scene, tool.
@@ -376,32 +379,38 @@ impl Context {
             Select {
                 max: usize::MAX,
                 branch: None,
+                cutoff: CLEARANCE_CUTOFF,
             },
         )
     }
 
-    /// [`Self::vertices`] restricted to the elbow/wrist branch `branch` ([`branch`]): the
+    /// [`Self::vertices`] restricted to the elbow/wrist branch `branch` ([`branch`]), with
+    /// clearances measured only below `below` (those at or above it read as `below`; never
+    /// below the required clearance, so validity is exact, nor above [`CLEARANCE_CUTOFF`]). The
     /// configurations of the other branches are not checked at all (nor counted in the
     /// rejections). The base-tolerance checks take only the planned branch, so they measure
-    /// the clearances of two IK solutions per target instead of eight.
+    /// two IK solutions per target instead of eight; and they want only the smallest clearance
+    /// over a pose's waypoints, so `below` is the smallest found so far.
     pub fn vertices_on_branch(
         &self,
         scene: &Scene,
-        base_from_world: &Iso,
         world_from_base: &Iso,
         world_tcp: &Iso,
         order: usize,
         branch: (bool, bool),
+        below: f64,
     ) -> (Vec<Vertex>, Rejections) {
+        let floor = self.opts.clearance.min(CLEARANCE_CUTOFF);
         self.vertices_upto(
             scene,
-            base_from_world,
+            &world_from_base.inverse(),
             world_from_base,
             world_tcp,
             order,
             Select {
                 max: usize::MAX,
                 branch: Some(branch),
+                cutoff: below.clamp(floor, CLEARANCE_CUTOFF),
             },
         )
     }
@@ -428,6 +437,7 @@ impl Context {
                 Select {
                     max: 1,
                     branch: None,
+                    cutoff: self.opts.clearance.min(CLEARANCE_CUTOFF),
                 },
             )
             .0
@@ -446,13 +456,9 @@ impl Context {
         Select {
             max,
             branch: on_branch,
+            cutoff,
         }: Select,
     ) -> (Vec<Vertex>, Rejections) {
-        let cutoff = if max == usize::MAX {
-            CLEARANCE_CUTOFF
-        } else {
-            self.opts.clearance.min(CLEARANCE_CUTOFF)
-        };
         let mut rej = Rejections::default();
         let mut out = Vec::new();
         let n_rot = if self.coaxial {

@@ -269,7 +269,6 @@ fn check_pose(
             return r;
         }
     };
-    let inv = world_from_base.inverse();
     let eps = plan.options.epsilon;
     for (li, l) in st.layers.iter().enumerate() {
         let order = first_order[si] + li;
@@ -287,8 +286,14 @@ fn check_pose(
             }
             r.checked += 1;
             let frame = ctx.target_frame(layer, k);
-            let (verts, rej) =
-                ctx.vertices_on_branch(&scene, &inv, &world_from_base, &frame, order, branch(&w.q));
+            let (verts, rej) = ctx.vertices_on_branch(
+                &scene,
+                &world_from_base,
+                &frame,
+                order,
+                branch(&w.q),
+                r.min_clearance,
+            );
             let point = format!("{at}: layer {} point {}", l.layer, w.index);
             resolver.next(
                 &w.q,
@@ -408,7 +413,10 @@ mod tests {
     /// (`vertices_on_branch`): at every waypoint of a small plan, from the planned base and from
     /// a corner of the default error box, they are exactly the full set's configurations on
     /// that branch (joints and clearances bit for bit), and the full set has the other
-    /// branches besides. So the resolver takes the same configuration either way.
+    /// branches besides. So the resolver takes the same configuration either way. Measured
+    /// only below a bound `below` (the smallest clearance found so far, in the check), the same
+    /// configurations come back, a clearance under the bound bit for bit and any other as the
+    /// bound: so the smallest clearance over the waypoints is the same number.
     #[test]
     fn the_planned_branch_alone_gives_the_full_sets_vertices_on_it() {
         let layers = cap_path(0.8, 0.2, 25.0, 0.008, 16, 12);
@@ -425,6 +433,7 @@ mod tests {
         let st = &plan.stations[0];
         let nominal = Iso::from_mat4(&st.world_from_base).unwrap();
         let mut others = 0;
+        let mut capped_any = false;
         for (dx, dy, da) in [(0.0, 0.0, 0.0), (0.01, -0.01, 1f64.to_radians())] {
             let w = Iso::translation(dx, dy, 0.0)
                 .mul(&nominal)
@@ -436,7 +445,8 @@ mod tests {
                     let frame = ctx.target_frame(&ctx.layers[order], k);
                     let b = branch(&wp.q);
                     let (all, _) = ctx.vertices(&scene, &inv, &w, &frame, order);
-                    let (on, _) = ctx.vertices_on_branch(&scene, &inv, &w, &frame, order, b);
+                    let (on, _) =
+                        ctx.vertices_on_branch(&scene, &w, &frame, order, b, f64::INFINITY);
                     let want: Vec<(Joints, f64)> = all
                         .iter()
                         .filter(|v| branch(&v.q) == b)
@@ -445,10 +455,22 @@ mod tests {
                     let got: Vec<(Joints, f64)> = on.iter().map(|v| (v.q, v.clearance)).collect();
                     assert_eq!(got, want, "layer {order} point {k}");
                     assert!(!got.is_empty(), "layer {order} point {k}: planned branch");
+                    // A bound between the required clearance and the cutoff, about half of
+                    // this point's own clearances: some read below it, some at it.
+                    let below = (got[0].1 * 0.999).max(ctx.opts.clearance);
+                    let (capped, _) = ctx.vertices_on_branch(&scene, &w, &frame, order, b, below);
+                    assert_eq!(capped.len(), got.len(), "layer {order} point {k}");
+                    for (c, (q, full)) in capped.iter().zip(&got) {
+                        assert_eq!(c.q, *q);
+                        let expect = if *full < below { *full } else { below };
+                        assert_eq!(c.clearance, expect, "layer {order} point {k}");
+                        capped_any |= *full >= below;
+                    }
                     others += all.len() - want.len();
                 }
             }
         }
         assert!(others > 0, "the full sets hold other branches too");
+        assert!(capped_any, "some clearances read as the bound");
     }
 }

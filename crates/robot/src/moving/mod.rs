@@ -490,7 +490,7 @@ impl Geometry {
             None => self.world.vertices(&self.scene, &w.inverse(), w, &frame, o),
             Some(b) => self
                 .world
-                .vertices_on_branch(&self.scene, &w.inverse(), w, &frame, o, b),
+                .vertices_on_branch(&self.scene, w, &frame, o, b, f64::INFINITY),
         };
         let need = self.world.opts.clearance;
         v.retain_mut(|x| {
