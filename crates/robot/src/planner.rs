@@ -415,6 +415,32 @@ impl Context {
         )
     }
 
+    /// [`Self::vertices`] with every clearance read as at most the required clearance: which
+    /// configurations are valid, not how clear they are (a query stops at the required
+    /// clearance, so most of the scene is skipped by its boxes). The station planner's ladder
+    /// needs no more; it measures the chosen configurations afterwards.
+    pub fn valid_vertices(
+        &self,
+        scene: &Scene,
+        base_from_world: &Iso,
+        world_from_base: &Iso,
+        world_tcp: &Iso,
+        order: usize,
+    ) -> (Vec<Vertex>, Rejections) {
+        self.vertices_upto(
+            scene,
+            base_from_world,
+            world_from_base,
+            world_tcp,
+            order,
+            Select {
+                max: usize::MAX,
+                branch: None,
+                cutoff: self.opts.clearance.min(CLEARANCE_CUTOFF),
+            },
+        )
+    }
+
     /// Whether a world TCP frame has any valid vertex ([`Self::vertices`] is non-empty): stops at
     /// the first one and measures clearances only up to the required clearance (a vertex is
     /// valid iff its clearance capped at any cutoff ≥ `clearance` is ≥ `clearance`), so the base
@@ -676,7 +702,7 @@ pub(crate) fn plan_station_cached(
             .par_iter()
             .map(|&(o, k)| {
                 let frame = ctx.target_frame(&ctx.layers[o], k);
-                ctx.vertices(&scene, &base_from_world, world_from_base, &frame, o)
+                ctx.valid_vertices(&scene, &base_from_world, world_from_base, &frame, o)
             })
             .collect();
         *cache = Some((range.start, built));
@@ -728,7 +754,8 @@ pub(crate) fn plan_station_cached(
             ));
         }
     };
-    let (unwrapped, clear) = match unwrap_path(ctx, built, &path) {
+    // The rungs' clearances are validity only (`valid_vertices`): `unwrap_path`'s are not used.
+    let (unwrapped, _) = match unwrap_path(ctx, built, &path) {
         Ok(p) => p,
         Err(WindUp { joint: j, lo, hi }) => {
             let l = &ctx.layers[range.start];
@@ -770,7 +797,14 @@ pub(crate) fn plan_station_cached(
                 let dq: Vec<f64> = (0..6).map(|j| q[j] - unwrapped[r - 1][j]).collect();
                 cost += dq[..n_cost].iter().map(|v| v * v).sum::<f64>();
             }
-            min_c = min_c.min(clear[r]);
+            // The layer's smallest clearance, each configuration measured only below the
+            // smallest so far: the same number as measuring every one in full (up to the
+            // cutoff), at a fraction of the queries. On the IK solution itself (`q` is it
+            // unwrapped by whole turns, which would round the link poses differently).
+            let canon = built[r].0[path.vertices[r]].q;
+            let env = ctx.env_model.pose(&canon, world_from_base);
+            let c = scene.clearance(env.as_slice(), o, min_c.min(CLEARANCE_CUTOFF));
+            min_c = min_c.min(c.distance);
             wps.push(Waypoint {
                 index: p.index,
                 t: t0,
