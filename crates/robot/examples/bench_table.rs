@@ -51,14 +51,7 @@ fn main() {
     let sc = t.elapsed().as_secs_f64() / qs.len() as f64 * 1e6;
 
     let layers = cap_path(0.8, 0.2, 25.0, 0.008, 120, 30);
-    let fixed = RobotSetup {
-        base: BasePlacement::Fixed {
-            world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                .to_mat4(),
-        },
-        ..RobotSetup::default()
-    };
+    let fixed = kappe_robot::synthetic::fixed_base_setup();
     let first60 = &layers[..60];
     let t = Instant::now();
     let p1 = plan_print(first60, &fixed, &PlanOptions::default());

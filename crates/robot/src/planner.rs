@@ -26,15 +26,59 @@ pub fn branch(q: &Joints) -> (bool, bool) {
     (q[2].sin() > 0.0, q[4].sin() > 0.0)
 }
 
-/// Which valid vertices [`Context::vertices_upto`] collects (at most `max`, and only those on
-/// `branch` when given) and how far their clearances are measured.
-#[derive(Clone, Copy)]
-struct Select {
-    max: usize,
-    branch: Option<(bool, bool)>,
-    /// Clearances at or above this are reported as it (a valid vertex needs a cutoff of at
-    /// least the required clearance).
-    cutoff: f64,
+/// Which valid vertices [`Context::vertices`] collects and how far it measures their
+/// clearances.
+#[derive(Clone, Copy, Debug)]
+pub struct Select {
+    /// At most this many (the first found).
+    pub max: usize,
+    /// Only those on this elbow/wrist branch ([`branch`]); the others are not checked at all,
+    /// nor counted in the rejections.
+    pub branch: Option<(bool, bool)>,
+    /// How far the clearances are measured.
+    pub measure: Measure,
+}
+
+/// How far [`Context::vertices`] measures clearances. A clearance at or above the bound reads as
+/// the bound; the bound is never below the required clearance (so validity is exact) nor above
+/// [`CLEARANCE_CUTOFF`].
+#[derive(Clone, Copy, Debug)]
+pub enum Measure {
+    /// Up to [`CLEARANCE_CUTOFF`].
+    Full,
+    /// Only whether the required clearance holds: a query stops there, so most of the scene
+    /// is skipped by its boxes.
+    Validity,
+    /// Below this bound: what a caller that wants only the smallest clearance over many
+    /// configurations needs (the smallest so far).
+    Below(f64),
+}
+
+impl Select {
+    /// Every valid vertex, clearances in full.
+    pub const ALL: Select = Select {
+        max: usize::MAX,
+        branch: None,
+        measure: Measure::Full,
+    };
+    /// Every valid vertex, validity only: the station planner's ladder, which measures the
+    /// configurations it chooses afterwards.
+    pub const VALID: Select = Select {
+        max: usize::MAX,
+        branch: None,
+        measure: Measure::Validity,
+    };
+
+    /// The valid vertices on `branch`, clearances below `below`: the base-tolerance checks,
+    /// which take only the planned branch (two IK solutions of eight) and want only the
+    /// smallest clearance over a pose's waypoints.
+    pub fn on_branch(branch: (bool, bool), below: f64) -> Select {
+        Select {
+            max: usize::MAX,
+            branch: Some(branch),
+            measure: Measure::Below(below),
+        }
+    }
 }
 
 /// Geometry shared by all stations: models, static scene, tool.
@@ -360,84 +404,23 @@ impl Context {
             && UR10E.shoulder_margin(base_from_flange) >= self.opts.min_shoulder_margin
     }
 
-    /// All valid vertices of a world TCP frame for base `world_from_base`; printed layers with
-    /// print order < `order` are obstacles.
+    /// The valid vertices of a world TCP frame for base `world_from_base` that `select` asks
+    /// for; printed layers with print order < `order` are obstacles.
     pub fn vertices(
         &self,
         scene: &Scene,
-        base_from_world: &Iso,
         world_from_base: &Iso,
         world_tcp: &Iso,
         order: usize,
+        select: Select,
     ) -> (Vec<Vertex>, Rejections) {
-        self.vertices_upto(
-            scene,
-            base_from_world,
-            world_from_base,
-            world_tcp,
-            order,
-            Select {
-                max: usize::MAX,
-                branch: None,
-                cutoff: CLEARANCE_CUTOFF,
-            },
-        )
-    }
-
-    /// [`Self::vertices`] restricted to the elbow/wrist branch `branch` ([`branch`]), with
-    /// clearances measured only below `below` (those at or above it read as `below`; never
-    /// below the required clearance, so validity is exact, nor above [`CLEARANCE_CUTOFF`]). The
-    /// configurations of the other branches are not checked at all (nor counted in the
-    /// rejections). The base-tolerance checks take only the planned branch, so they measure
-    /// two IK solutions per target instead of eight; and they want only the smallest clearance
-    /// over a pose's waypoints, so `below` is the smallest found so far.
-    pub fn vertices_on_branch(
-        &self,
-        scene: &Scene,
-        world_from_base: &Iso,
-        world_tcp: &Iso,
-        order: usize,
-        branch: (bool, bool),
-        below: f64,
-    ) -> (Vec<Vertex>, Rejections) {
-        let floor = self.opts.clearance.min(CLEARANCE_CUTOFF);
         self.vertices_upto(
             scene,
             &world_from_base.inverse(),
             world_from_base,
             world_tcp,
             order,
-            Select {
-                max: usize::MAX,
-                branch: Some(branch),
-                cutoff: below.clamp(floor, CLEARANCE_CUTOFF),
-            },
-        )
-    }
-
-    /// [`Self::vertices`] with every clearance read as at most the required clearance: which
-    /// configurations are valid, not how clear they are (a query stops at the required
-    /// clearance, so most of the scene is skipped by its boxes). The station planner's ladder
-    /// needs no more; it measures the chosen configurations afterwards.
-    pub fn valid_vertices(
-        &self,
-        scene: &Scene,
-        base_from_world: &Iso,
-        world_from_base: &Iso,
-        world_tcp: &Iso,
-        order: usize,
-    ) -> (Vec<Vertex>, Rejections) {
-        self.vertices_upto(
-            scene,
-            base_from_world,
-            world_from_base,
-            world_tcp,
-            order,
-            Select {
-                max: usize::MAX,
-                branch: None,
-                cutoff: self.opts.clearance.min(CLEARANCE_CUTOFF),
-            },
+            select,
         )
     }
 
@@ -462,16 +445,15 @@ impl Context {
                 order,
                 Select {
                     max: 1,
-                    branch: None,
-                    cutoff: self.opts.clearance.min(CLEARANCE_CUTOFF),
+                    ..Select::VALID
                 },
             )
             .0
             .is_empty()
     }
 
-    /// The valid vertices as `select` asks; with `max < usize::MAX` clearances are
-    /// measured only up to the required clearance (see [`Self::has_vertex`]).
+    /// [`Self::vertices`] with the base's inverse given (the planner's rungs and the base search
+    /// share one per pose).
     fn vertices_upto(
         &self,
         scene: &Scene,
@@ -482,9 +464,15 @@ impl Context {
         Select {
             max,
             branch: on_branch,
-            cutoff,
+            measure,
         }: Select,
     ) -> (Vec<Vertex>, Rejections) {
+        let floor = self.opts.clearance.min(CLEARANCE_CUTOFF);
+        let cutoff = match measure {
+            Measure::Full => CLEARANCE_CUTOFF,
+            Measure::Validity => floor,
+            Measure::Below(b) => b.clamp(floor, CLEARANCE_CUTOFF),
+        };
         let mut rej = Rejections::default();
         let mut out = Vec::new();
         let n_rot = if self.coaxial {
@@ -702,7 +690,14 @@ pub(crate) fn plan_station_cached(
             .par_iter()
             .map(|&(o, k)| {
                 let frame = ctx.target_frame(&ctx.layers[o], k);
-                ctx.valid_vertices(&scene, &base_from_world, world_from_base, &frame, o)
+                ctx.vertices_upto(
+                    &scene,
+                    &base_from_world,
+                    world_from_base,
+                    &frame,
+                    o,
+                    Select::VALID,
+                )
             })
             .collect();
         *cache = Some((range.start, built));
@@ -754,7 +749,7 @@ pub(crate) fn plan_station_cached(
             ));
         }
     };
-    // The rungs' clearances are validity only (`valid_vertices`): `unwrap_path`'s are not used.
+    // The rungs' clearances are validity only (`Select::VALID`): `unwrap_path`'s are not used.
     let (unwrapped, _) = match unwrap_path(ctx, built, &path) {
         Ok(p) => p,
         Err(WindUp { joint: j, lo, hi }) => {

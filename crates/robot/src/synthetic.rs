@@ -52,3 +52,19 @@ pub fn cap_path(
         })
         .collect()
 }
+
+/// The set-up the tests and benchmarks plan [`cap_path`] from: the default UR10e on its mobile
+/// base, fixed 1.0 m in front of the first layer (world y = 1 m) and turned to face it (−90°
+/// about z: the base's x axis along world −y). From there the first ~60 layers of the default
+/// synthetic cap are reachable (`examples/try_bases.rs`).
+pub fn fixed_base_setup() -> crate::setup::RobotSetup {
+    use crate::frames::Iso;
+    crate::setup::RobotSetup {
+        base: crate::setup::BasePlacement::Fixed {
+            world_from_base: Iso::translation(0.0, 1.0, 0.0)
+                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
+                .to_mat4(),
+        },
+        ..crate::setup::RobotSetup::default()
+    }
+}

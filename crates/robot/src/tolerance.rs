@@ -20,7 +20,7 @@
 //! printed layers as obstacles); the one nearest the planned joints on the same elbow/wrist branch
 //! is taken, and consecutive ones must stay within the plan's compatibility ε (the trajectory is
 //! re-solvable without a reconfiguration). Only the planned branch's IK solutions are checked at
-//! all ([`crate::planner::Context::vertices_on_branch`]): the other six of the eight could never
+//! all ([`crate::planner::Select::on_branch`]): the other six of the eight could never
 //! be taken, and measuring their clearances was most of the check's time (`kappe design` of the
 //! moving bay example: 95 → 37 s; the 1.5 m × 4 m bay: 78 → 58 s; the same reports). Hand-written: it is a property of this planner's
 //! acceptance rules, which no crate knows.
@@ -32,7 +32,7 @@ use crate::collision::{Obstacle, Scene};
 use crate::frames::Iso;
 use crate::kinematics::{Joints, joint_delta};
 use crate::plan::{Plan, plan_layers};
-use crate::planner::{Rejections, Vertex, branch, validate};
+use crate::planner::{Rejections, Select, Vertex, branch, validate};
 pub use crate::setup::{BaseTolerance, sampled_errors};
 
 /// The result of [`check_base_tolerance`]; the plan tolerates the errors when `problems` is empty.
@@ -286,13 +286,12 @@ fn check_pose(
             }
             r.checked += 1;
             let frame = ctx.target_frame(layer, k);
-            let (verts, rej) = ctx.vertices_on_branch(
+            let (verts, rej) = ctx.vertices(
                 &scene,
                 &world_from_base,
                 &frame,
                 order,
-                branch(&w.q),
-                r.min_clearance,
+                Select::on_branch(branch(&w.q), r.min_clearance),
             );
             let point = format!("{at}: layer {} point {}", l.layer, w.index);
             resolver.next(
@@ -406,11 +405,11 @@ pub fn station_margins(plan: &Plan, tol: &BaseTolerance) -> Vec<StationMargin> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::setup::{BasePlacement, PlanOptions, RobotSetup};
+    use crate::setup::PlanOptions;
     use crate::synthetic::cap_path;
 
     /// The tolerance check measures only the planned branch's configurations
-    /// (`vertices_on_branch`): at every waypoint of a small plan, from the planned base and from
+    /// (`Select::on_branch`): at every waypoint of a small plan, from the planned base and from
     /// a corner of the default error box, they are exactly the full set's configurations on
     /// that branch (joints and clearances bit for bit), and the full set has the other
     /// branches besides. So the resolver takes the same configuration either way. Measured
@@ -420,14 +419,7 @@ mod tests {
     #[test]
     fn the_planned_branch_alone_gives_the_full_sets_vertices_on_it() {
         let layers = cap_path(0.8, 0.2, 25.0, 0.008, 16, 12);
-        let setup = RobotSetup {
-            base: BasePlacement::Fixed {
-                world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                    .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                    .to_mat4(),
-            },
-            ..RobotSetup::default()
-        };
+        let setup = crate::synthetic::fixed_base_setup();
         let plan = crate::plan_print(&layers, &setup, &PlanOptions::default()).unwrap();
         let ctx = validate(&plan_layers(&plan), &plan.setup, &plan.options).unwrap();
         let st = &plan.stations[0];
@@ -439,14 +431,18 @@ mod tests {
                 .mul(&nominal)
                 .mul(&Iso::rot_z(da));
             let scene = ctx.scene(&w).unwrap();
-            let inv = w.inverse();
             for (order, l) in st.layers.iter().enumerate() {
                 for (k, wp) in l.waypoints.iter().enumerate() {
                     let frame = ctx.target_frame(&ctx.layers[order], k);
                     let b = branch(&wp.q);
-                    let (all, _) = ctx.vertices(&scene, &inv, &w, &frame, order);
-                    let (on, _) =
-                        ctx.vertices_on_branch(&scene, &w, &frame, order, b, f64::INFINITY);
+                    let (all, _) = ctx.vertices(&scene, &w, &frame, order, Select::ALL);
+                    let (on, _) = ctx.vertices(
+                        &scene,
+                        &w,
+                        &frame,
+                        order,
+                        Select::on_branch(b, f64::INFINITY),
+                    );
                     let want: Vec<(Joints, f64)> = all
                         .iter()
                         .filter(|v| branch(&v.q) == b)
@@ -458,7 +454,8 @@ mod tests {
                     // A bound between the required clearance and the cutoff, about half of
                     // this point's own clearances: some read below it, some at it.
                     let below = (got[0].1 * 0.999).max(ctx.opts.clearance);
-                    let (capped, _) = ctx.vertices_on_branch(&scene, &w, &frame, order, b, below);
+                    let (capped, _) =
+                        ctx.vertices(&scene, &w, &frame, order, Select::on_branch(b, below));
                     assert_eq!(capped.len(), got.len(), "layer {order} point {k}");
                     for (c, (q, full)) in capped.iter().zip(&got) {
                         assert_eq!(c.q, *q);

@@ -4,8 +4,6 @@
 use std::path::Path;
 
 use crate::common::{kappe, text};
-use kappe_robot::frames::Iso;
-use kappe_robot::setup::{BasePlacement, RobotSetup};
 use kappe_robot::synthetic::cap_path;
 
 /// 4 layers of 12 points of the synthetic cap and a config with the base fixed in front of it
@@ -21,14 +19,7 @@ fn setup(dir: &Path) {
         }
     }
     std::fs::write(dir.join("path.csv"), csv).unwrap();
-    let setup = RobotSetup {
-        base: BasePlacement::Fixed {
-            world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                .to_mat4(),
-        },
-        ..RobotSetup::default()
-    };
+    let setup = kappe_robot::synthetic::fixed_base_setup();
     let config = serde_json::json!({
         "setup": setup,
         "options": { "program": { "max_moves_per_program": 30 } }

@@ -388,8 +388,12 @@ pub fn check_moving_tolerance(
                     continue;
                 }
                 n += 1;
-                let (verts, rej) =
-                    geo.vertices_where(&off(k), li, k, Some(crate::planner::branch(&w.q)));
+                let (verts, rej) = geo.vertices_where(
+                    &off(k),
+                    li,
+                    k,
+                    crate::planner::Select::on_branch(crate::planner::branch(&w.q), f64::INFINITY),
+                );
                 let point = format!("{at}: point {}", w.index);
                 resolver.next(&w.q, &verts, &rej, &point, &mut min_c, &mut pr);
             }

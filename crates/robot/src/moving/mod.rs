@@ -66,7 +66,7 @@ use crate::error::RobotError;
 use crate::frames::Iso;
 use crate::kinematics::Joints;
 use crate::plan::{CLEARANCE_CUTOFF, Plan, Waypoint};
-use crate::planner::{Context, Rejections, Vertex, validate};
+use crate::planner::{Context, Rejections, Select, Vertex, validate};
 use crate::setup::PrintLayer;
 
 mod check;
@@ -473,25 +473,20 @@ impl Geometry {
 
     /// Valid vertices of target (o, k) from base pose `w`.
     fn vertices(&self, w: &Iso, o: usize, k: usize) -> (Vec<Vertex>, Rejections) {
-        self.vertices_where(w, o, k, None)
+        self.vertices_where(w, o, k, Select::ALL)
     }
 
-    /// [`Self::vertices`], only those on elbow/wrist branch `on_branch` when given
-    /// ([`crate::planner::Context::vertices_on_branch`]).
+    /// [`Self::vertices`] as `select` asks ([`crate::planner::Context::vertices`]), the mobile
+    /// base's body included.
     fn vertices_where(
         &self,
         w: &Iso,
         o: usize,
         k: usize,
-        on_branch: Option<(bool, bool)>,
+        select: Select,
     ) -> (Vec<Vertex>, Rejections) {
         let frame = self.world.target_frame(&self.world.layers[o], k);
-        let (mut v, mut rej) = match on_branch {
-            None => self.world.vertices(&self.scene, &w.inverse(), w, &frame, o),
-            Some(b) => self
-                .world
-                .vertices_on_branch(&self.scene, w, &frame, o, b, f64::INFINITY),
-        };
+        let (mut v, mut rej) = self.world.vertices(&self.scene, w, &frame, o, select);
         let need = self.world.opts.clearance;
         v.retain_mut(|x| {
             let c = self.body_clearance(&x.q, CLEARANCE_CUTOFF);

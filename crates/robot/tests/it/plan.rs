@@ -8,14 +8,7 @@ use kappe_robot::*;
 /// `examples/try_bases.rs`: from there the first ~60 layers are reachable).
 fn small() -> (Vec<PrintLayer>, RobotSetup, PlanOptions) {
     let layers = cap_path(0.8, 0.2, 25.0, 0.008, 16, 12);
-    let setup = RobotSetup {
-        base: BasePlacement::Fixed {
-            world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                .to_mat4(),
-        },
-        ..RobotSetup::default()
-    };
+    let setup = kappe_robot::synthetic::fixed_base_setup();
     (layers, setup, PlanOptions::default())
 }
 

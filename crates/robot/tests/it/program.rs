@@ -11,14 +11,7 @@ use kappe_robot::*;
 /// 16 layers of 12 points from a fixed base (as in `plan.rs`), ≤ 50 targets per program.
 fn small() -> (Vec<PrintLayer>, RobotSetup, PlanOptions) {
     let layers = cap_path(0.8, 0.2, 25.0, 0.008, 16, 12);
-    let setup = RobotSetup {
-        base: BasePlacement::Fixed {
-            world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                .to_mat4(),
-        },
-        ..RobotSetup::default()
-    };
+    let setup = kappe_robot::synthetic::fixed_base_setup();
     let opts = PlanOptions {
         program: ProgramOptions {
             max_moves_per_program: 50,

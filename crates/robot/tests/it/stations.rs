@@ -60,14 +60,7 @@ fn greedy_stations_are_fewest() {
 
 fn small(layers: usize) -> (Vec<PrintLayer>, RobotSetup, PlanOptions) {
     let layers = cap_path(0.8, 0.2, 25.0, 0.008, layers, 12);
-    let setup = RobotSetup {
-        base: BasePlacement::Fixed {
-            world_from_base: Iso::translation(0.0, 1.0, 0.0)
-                .mul(&Iso::rot_z(1.5 * std::f64::consts::PI))
-                .to_mat4(),
-        },
-        ..RobotSetup::default()
-    };
+    let setup = kappe_robot::synthetic::fixed_base_setup();
     (layers, setup, PlanOptions::default())
 }
 
