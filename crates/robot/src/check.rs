@@ -156,8 +156,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                 Ok(qa) => {
                     let posed = ctx.self_model.pose(&qa, &Iso::IDENTITY);
                     let (ds, _) = ctx.self_model.min_self_distance_posed(&posed);
-                    let env = ctx.env_model.pose(&qa, &world_from_base);
-                    let c = scene.clearance(env.as_slice(), tag, CLEARANCE_CUTOFF);
+                    let c = ctx.clearance(&scene, &qa, &world_from_base, tag, CLEARANCE_CUTOFF);
                     if ds < opts.self_clearance || (c.distance <= 1e-12 && c.object.is_some()) {
                         problems.push(format!(
                             "station {}: the {what} pose collides ({:?})",
@@ -205,8 +204,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
             // proof that the margin holds (tight only where it is near the margin).
             let (path, tag, required, _) = &motions[k];
             let measure = |q: &Joints| -> [f64; 2] {
-                let env = ctx.env_model.pose(q, &world_from_base);
-                let c = scene.clearance(env.as_slice(), *tag, CLEARANCE_CUTOFF);
+                let c = ctx.clearance(&scene, q, &world_from_base, *tag, CLEARANCE_CUTOFF);
                 let posed = ctx.self_model.pose(q, &Iso::IDENTITY);
                 [c.distance, ctx.self_model.min_self_distance_posed(&posed).0]
             };
@@ -292,8 +290,7 @@ pub fn check_plan(plan: &Plan) -> CheckReport {
                         at()
                     ));
                 }
-                let env = ctx.env_model.pose(&q, &world_from_base);
-                let c = scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
+                let c = ctx.clearance(&scene, &q, &world_from_base, order, CLEARANCE_CUTOFF);
                 rep.min_clearance = rep.min_clearance.min(c.distance);
                 if c.distance < opts.clearance - 1e-9 {
                     problems.push(format!(

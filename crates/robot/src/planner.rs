@@ -12,7 +12,9 @@
 use parry3d_f64::glamx::DVec3;
 use rayon::prelude::*;
 
-use crate::collision::{CapsuleSpec, LINK_NAMES, Obstacle, RobotModel, Scene, TOOL_LINK};
+use crate::collision::{
+    CapsuleSpec, Clearance, LINK_NAMES, Obstacle, RobotModel, Scene, TOOL_LINK,
+};
 use crate::error::{FailureKind, PlanFailure, RobotError};
 use crate::frames::{Iso, frame_from_z};
 use crate::kinematics::{Joints, UR10E, joint_delta, representable_in_limits};
@@ -384,6 +386,21 @@ impl Context {
         d[..n_cost].iter().map(|v| v * v).sum()
     }
 
+    /// The arm's clearance to `scene` in configuration `q` from base `world_from_base`: its
+    /// environment capsules against the static obstacles and the printed layers with print order
+    /// < `order`, measured up to `cutoff` ([`Scene::clearance`]).
+    pub fn clearance(
+        &self,
+        scene: &Scene,
+        q: &Joints,
+        world_from_base: &Iso,
+        order: usize,
+        cutoff: f64,
+    ) -> Clearance {
+        let env = self.env_model.pose(q, world_from_base);
+        scene.clearance(env.as_slice(), order, cutoff)
+    }
+
     /// TCP frame of a target (φ = 0), world: z = tool axis, x from the path tangent.
     pub fn target_frame(&self, layer: &PrintLayer, k: usize) -> Iso {
         let pts = &layer.points;
@@ -509,8 +526,7 @@ impl Context {
                     rej.self_example.get_or_insert(pair);
                     continue;
                 }
-                let env = self.env_model.pose(&q, world_from_base);
-                let c = scene.clearance(env.as_slice(), order, cutoff);
+                let c = self.clearance(scene, &q, world_from_base, order, cutoff);
                 if c.distance < self.opts.clearance {
                     rej.collision += 1;
                     if rej.collision_example.is_none() {
@@ -749,8 +765,7 @@ pub(crate) fn plan_station_cached(
             ));
         }
     };
-    // The rungs' clearances are validity only (`Select::VALID`): `unwrap_path`'s are not used.
-    let (unwrapped, _) = match unwrap_path(ctx, built, &path) {
+    let unwrapped = match unwrap_path(ctx, built, &path) {
         Ok(p) => p,
         Err(WindUp { joint: j, lo, hi }) => {
             let l = &ctx.layers[range.start];
@@ -794,11 +809,16 @@ pub(crate) fn plan_station_cached(
             }
             // The layer's smallest clearance, each configuration measured only below the
             // smallest so far: the same number as measuring every one in full (up to the
-            // cutoff), at a fraction of the queries. On the IK solution itself (`q` is it
-            // unwrapped by whole turns, which would round the link poses differently).
+            // cutoff), at a fraction of the queries. Measured on the IK solution itself, not on
+            // `q` (the same joints unwrapped by whole turns, whose link poses round differently).
             let canon = built[r].0[path.vertices[r]].q;
-            let env = ctx.env_model.pose(&canon, world_from_base);
-            let c = scene.clearance(env.as_slice(), o, min_c.min(CLEARANCE_CUTOFF));
+            let c = ctx.clearance(
+                &scene,
+                &canon,
+                world_from_base,
+                o,
+                min_c.min(CLEARANCE_CUTOFF),
+            );
             min_c = min_c.min(c.distance);
             wps.push(Waypoint {
                 index: p.index,
@@ -873,25 +893,19 @@ pub(crate) struct WindUp {
     pub hi: f64,
 }
 
-/// The joints and clearances along a ladder path: the canonical vertices unwrapped (each step
+/// The joints along a ladder path: the canonical vertices unwrapped (each step
 /// the wrapped Δq; the elbow raw) and every joint shifted by the multiple of 2π that keeps its
 /// whole travel inside the limits with its middle nearest zero.
 pub(crate) fn unwrap_path(
     ctx: &Context,
     built: &[(Vec<Vertex>, Rejections)],
     path: &LadderPath,
-) -> Result<(Vec<Joints>, Vec<f64>), WindUp> {
+) -> Result<Vec<Joints>, WindUp> {
     let canon: Vec<Joints> = path
         .vertices
         .iter()
         .enumerate()
         .map(|(r, &v)| built[r].0[v].q)
-        .collect();
-    let clear: Vec<f64> = path
-        .vertices
-        .iter()
-        .enumerate()
-        .map(|(r, &v)| built[r].0[v].clearance)
         .collect();
     let mut unwrapped = canon.clone();
     for r in 1..canon.len() {
@@ -925,7 +939,7 @@ pub(crate) fn unwrap_path(
             q[j] += s;
         }
     }
-    Ok((unwrapped, clear))
+    Ok(unwrapped)
 }
 
 /// Check the joint-interpolated move a → b at ≤ 1° steps; `order` is the layer about to start
@@ -953,8 +967,7 @@ pub(crate) fn transition_collision(
                 100.0 * u
             ));
         }
-        let env = ctx.env_model.pose(&q, world_from_base);
-        let c = scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
+        let c = ctx.clearance(scene, &q, world_from_base, order, CLEARANCE_CUTOFF);
         if c.distance < 0.0 + 1e-12 && c.object.is_some() {
             return Some(format!(
                 "{} hits {:?} at {:.0} % of the move",

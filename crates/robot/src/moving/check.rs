@@ -142,8 +142,7 @@ pub fn check_moving(mp: &MovingPlan) -> MovingCheck {
     }
     rep.waypoints = rows.len();
     let measure = |q: &Joints, w: &Iso, order: usize| -> f64 {
-        let env = ctx.env_model.pose(q, w);
-        let c = geo.scene.clearance(env.as_slice(), order, CLEARANCE_CUTOFF);
+        let c = ctx.clearance(&geo.scene, q, w, order, CLEARANCE_CUTOFF);
         c.distance.min(geo.body_clearance(q, CLEARANCE_CUTOFF))
     };
     let per_row: Vec<(f64, f64, f64, f64, Vec<String>)> = rows

@@ -272,7 +272,7 @@ fn plan_with_lead(
         }
     };
     // Unwrap (elbow raw) and one 2π offset per joint, as the station planner.
-    let (q, clear) = match unwrap_path(ctx, &built, &path) {
+    let q = match unwrap_path(ctx, &built, &path) {
         Ok(p) => p,
         Err(WindUp { joint: j, lo, hi }) => {
             return Err(fail(
@@ -299,7 +299,7 @@ fn plan_with_lead(
                     .map(|j| (q[r][j] - q[r - 1][j]).powi(2))
                     .sum::<f64>();
             }
-            min_c = min_c.min(clear[r]);
+            min_c = min_c.min(built[r].0[path.vertices[r]].clearance);
             wps.push(Waypoint {
                 index: p.index,
                 t: 0.0,
