@@ -13,18 +13,19 @@
 //! a narrow strip: on the default cap linear interpolation of c over 4 states is off by less than
 //! 0.005 % from state 60 on, while the start section's first 40 states jump by up to 0.7 %.
 //! So the split is solved on a sample of states chosen adaptively, by bisection along the
-//! print sequence ([`sample`]): the midpoint of an interval is solved, then its quarter points;
+//! print sequence ([`sample`]) from initial samples whose spacing doubles ([`SAMPLE_FIRST`]):
+//! the midpoint of an interval is solved with its quarter points (in one batch);
 //! if their ratios agree with the quadratic through the ends and the midpoint to within
 //! `tolerance/10`, the interval's other states are interpolated on that quadratic, otherwise
 //! both halves are bisected, until every state is either solved or inside an accepted interval
 //! (intervals under 4 states: the midpoint against the straight line). Probing the midpoint
 //! alone missed single-state jumps of the start section. An
 //! interpolated state's factor is still its own mesh's factor, corrected by the interpolated
-//! ratio; its bracket is widened by twice the probes' disagreement on both sides, and its
-//! reported value moved down by the same amount (the safe side).
+//! ratio; its bracket is widened on both sides by 2 × [`SAMPLE_SAFETY`] × the probes'
+//! disagreement, and its reported value moved down by the same amount (the safe side).
 //!
 //! **Spending the budget.** A wider disagreement (up to `tolerance/2`) is still interpolated
-//! when the widened bracket (then twice as wide again, [`SAMPLE_SAFETY`]) keeps every state of
+//! when the widened bracket keeps every state of
 //! the interval within the contract: its `blf_error` within the tolerance, or its safe value
 //! above the smallest upper bracket end of the states solved so far, so that it cannot govern.
 //! That spares the split where the ratio wobbles but the factor is far from governing: the
@@ -50,16 +51,24 @@ pub const SAMPLE_SHARE: f64 = 1.0 / 10.0;
 /// while the ratio is smooth on the scale of the probe spacing.
 pub const SAMPLE_SHARE_MAX: f64 = 1.0 / 2.0;
 
-/// The safety factor on the probe disagreement of an interval interpolated under the relaxed
-/// test (`SAMPLE_SHARE` < e ≤ `SAMPLE_SHARE_MAX`): its states' brackets are widened by
-/// 2 × this × e on each side (2: Richardson doubles an error of the ratio). On the default,
+/// The safety factor on the probe disagreement e of an interpolated interval: its states'
+/// brackets are widened by 2 × this × e on each side (2: Richardson doubles an error of the
+/// ratio). Under the relaxed test (`SAMPLE_SHARE` < e ≤ `SAMPLE_SHARE_MAX`) on the default,
 /// corrugated and 1.2 m caps, 1 left interpolated start-section and wave states up to 0.3 %
 /// above their value with the split in every state (a foot merge or a mode change between the
-/// probes); 2 left none (docs/convergence.md, "Levers on the `speed4` branch").
+/// probes); 2 left none (docs/convergence.md, "Levers on the `speed4` branch"). Since session 14
+/// it applies under the strict test too: with the doubling initial spacing a strictly accepted
+/// interval of a wobbling ratio left a state 0.002 % above its own pair at 1 (the unit test
+/// `a_wobbling_ratio_is_interpolated_only_where_it_cannot_govern`).
 pub const SAMPLE_SAFETY: f64 = 2.0;
 
-/// Initial spacing of the samples (states), before bisection.
-pub const SAMPLE_STRIDE: usize = 32;
+/// The first sample after the first state, before bisection: the initial samples are the
+/// first state, this position, and every doubling of it, and the last state (0, 16, 32, 64,
+/// 128, …, n − 1). The ratio changes with the shell's shape, and one more row changes a shell
+/// of k rows by about 1/k of itself: a spacing that grows with the position keeps the change
+/// per interval about the same, where a fixed stride over-samples the large, smooth and costly
+/// late states (docs/convergence.md, "Session 14").
+pub const SAMPLE_FIRST: usize = 16;
 
 /// Solves the split mesh of a batch of states: (state, converged estimate) per state.
 pub type SplitSolve<'a, E> = dyn FnMut(&[usize]) -> Result<Vec<(usize, ConvergedFactor)>, E> + 'a;
@@ -102,25 +111,35 @@ pub fn sample<E>(
         return Ok(Vec::new());
     }
     // Without sampling every state is a sample.
-    let stride = if sampling { SAMPLE_STRIDE } else { 1 };
-    let mut first: Vec<usize> = (0..n).step_by(stride).collect();
+    let mut first: Vec<usize> = if sampling {
+        std::iter::once(0)
+            .chain(std::iter::successors(Some(SAMPLE_FIRST), |p| {
+                p.checked_mul(2)
+            }))
+            .take_while(|&p| p < n)
+            .collect()
+    } else {
+        (0..n).collect()
+    };
     first.push(n - 1);
     first.dedup();
     run(first.clone(), &mut solved)?;
-    // (a, b, quarters): the midpoint is probed first, then (intervals of 4 or more) the quarter
-    // points, against the quadratic through the ends and the midpoint.
-    let mut intervals: Vec<(usize, usize, bool)> =
-        first.windows(2).map(|w| (w[0], w[1], false)).collect();
+    // (a, b): the midpoint is probed and, in an interval of 4 or more, the quarter points with
+    // it, tested against the quadratic through the ends and the midpoint (a short interval's
+    // midpoint against the straight line). An interval of 4 or more always needs its quarters
+    // (the midpoint alone cannot accept it, and its halves' midpoints are the same states), so
+    // they are solved in the midpoint's batch: one round fewer per level, the same states.
+    let mut intervals: Vec<(usize, usize)> = first.windows(2).map(|w| (w[0], w[1])).collect();
     let tau = tolerance * SAMPLE_SHARE;
     let tau_max = tolerance * SAMPLE_SHARE_MAX;
     while !intervals.is_empty() {
         let todo: Vec<usize> = intervals
             .iter()
-            .filter(|(a, b, _)| b - a >= 2)
-            .flat_map(|&(a, b, quarters)| {
+            .filter(|(a, b)| b - a >= 2)
+            .flat_map(|&(a, b)| {
                 let m = (a + b) / 2;
-                if quarters {
-                    vec![(a + m) / 2, (m + b) / 2]
+                if b - a >= 4 {
+                    vec![(a + m) / 2, m, (m + b) / 2]
                 } else {
                     vec![m]
                 }
@@ -142,10 +161,10 @@ pub fn sample<E>(
         // tolerance only of the states that could govern. Returns the half-width of the
         // interpolated ratios' bracket when the interval is accepted.
         let fits = |a: usize, b: usize, e: f64| {
-            if e <= tau {
-                return Some(e);
-            }
             let widened = SAMPLE_SAFETY * e;
+            if e <= tau {
+                return Some(widened);
+            }
             (e <= tau_max
                 && (a + 1..b).all(|p| {
                     estimate(coarse, &solved, a, b, p, widened, tolerance)
@@ -154,7 +173,7 @@ pub fn sample<E>(
             .then_some(widened)
         };
         let mut next = Vec::new();
-        for (a, b, quarters) in intervals {
+        for (a, b) in intervals {
             if b - a < 2 {
                 continue;
             }
@@ -162,7 +181,7 @@ pub fn sample<E>(
             let r = |p: usize| solved[p].as_ref().map(ratio);
             // The worst disagreement of the probes with the interpolation of the others (a
             // solve without a factor counts as a disagreement).
-            let e = if quarters {
+            let e = if b - a >= 4 {
                 [(a + m) / 2, (m + b) / 2]
                     .into_iter()
                     .map(|p| Some((interp(a, m, b, r(a)?, r(m)?, r(b)?, p) - r(p)?).abs()))
@@ -170,19 +189,15 @@ pub fn sample<E>(
             } else {
                 (|| Some((interp(a, a, b, r(a)?, r(a)?, r(b)?, m) - r(m)?).abs()))()
             };
-            let widened = e
-                .filter(|_| quarters || b - a < 4)
-                .and_then(|e| fits(a, b, e));
-            match e {
-                Some(_) if widened.is_some() => {
+            match e.and_then(|e| fits(a, b, e)) {
+                Some(w) => {
                     for slot in accepted.iter_mut().take(b).skip(a + 1) {
-                        *slot = widened.map(|w| (a, b, w));
+                        *slot = Some((a, b, w));
                     }
                 }
-                Some(_) if !quarters && b - a >= 4 => next.push((a, b, true)),
-                _ => {
-                    next.push((a, m, false));
-                    next.push((m, b, false));
+                None => {
+                    next.push((a, m));
+                    next.push((m, b));
                 }
             }
         }
@@ -357,10 +372,10 @@ mod tests {
         let flat: Vec<(usize, f64)> = (0..n).map(|i| (i, 5.0 + 5e-5 * i as f64)).collect();
         // Where the relaxed test interpolates (far), the brackets cover the states' own pairs.
         // Where only the strict test may (near), an interval whose probes agree to within
-        // `tolerance/10` is interpolated with its bracket widened by that agreement alone, and
-        // a state between the probes can miss it by about as much again (a smooth wobble like
-        // this one: 2·Richardson·(tolerance/10) = 0.2 % of the factor; a jump between the probes
-        // can miss it by more, as before the relaxed test; docs/convergence.md).
+        // `tolerance/10` is interpolated with its bracket widened by `SAMPLE_SAFETY` times that
+        // agreement, and a state between the probes could still miss it (a smooth wobble like
+        // this one: by at most 2·Richardson·(tolerance/10) = 0.2 % of the factor; a jump between
+        // the probes can miss it by more, as before the relaxed test; docs/convergence.md).
         let (far, near) = (run(&falling, 0.0), run(&flat, 0.002));
         assert!(
             far < near,
