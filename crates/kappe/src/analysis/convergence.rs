@@ -110,19 +110,7 @@ pub fn sample<E>(
     if n == 0 {
         return Ok(Vec::new());
     }
-    // Without sampling every state is a sample.
-    let mut first: Vec<usize> = if sampling {
-        std::iter::once(0)
-            .chain(std::iter::successors(Some(SAMPLE_FIRST), |p| {
-                p.checked_mul(2)
-            }))
-            .take_while(|&p| p < n)
-            .collect()
-    } else {
-        (0..n).collect()
-    };
-    first.push(n - 1);
-    first.dedup();
+    let first = initial(n, sampling);
     run(first.clone(), &mut solved)?;
     // (a, b): the midpoint is probed and, in an interval of 4 or more, the quarter points with
     // it, tested against the quadratic through the ends and the midpoint (a short interval's
@@ -217,6 +205,28 @@ pub fn sample<E>(
         }
     }
     Ok(out)
+}
+
+/// The positions (in print order, among `n` states) that [`sample`] solves first, before any
+/// result is known: the first, [`SAMPLE_FIRST`] and its doublings, and the last; every position
+/// without `sampling`.
+fn initial(n: usize, sampling: bool) -> Vec<usize> {
+    if n == 0 {
+        return Vec::new();
+    }
+    let mut first: Vec<usize> = if sampling {
+        std::iter::once(0)
+            .chain(std::iter::successors(Some(SAMPLE_FIRST), |p| {
+                p.checked_mul(2)
+            }))
+            .take_while(|&p| p < n)
+            .collect()
+    } else {
+        (0..n).collect()
+    };
+    first.push(n - 1);
+    first.dedup();
+    first
 }
 
 /// The mesh-correction ratio λ_f/λ_c of a solved state (1 without a split level).
