@@ -391,7 +391,7 @@ pub fn check_moving_tolerance(
                     &off(k),
                     li,
                     k,
-                    crate::planner::Select::on_branch(crate::planner::branch(&w.q), f64::INFINITY),
+                    crate::planner::Select::on_branch(crate::planner::branch(&w.q), min_c),
                 );
                 let point = format!("{at}: point {}", w.index);
                 resolver.next(&w.q, &verts, &rej, &point, &mut min_c, &mut pr);
