@@ -394,6 +394,19 @@ mod tests {
         assert!(far <= n / 3, "{far} solves");
     }
 
+    /// The first batch: dense at the start, doubling after, always the first and the last
+    /// state; every state without sampling; nothing for no states.
+    #[test]
+    fn the_first_batch_doubles_its_spacing() {
+        assert_eq!(initial(113, true), vec![0, 16, 32, 64, 112]);
+        assert_eq!(initial(197, true), vec![0, 16, 32, 64, 128, 196]);
+        assert_eq!(initial(17, true), vec![0, 16]);
+        assert_eq!(initial(10, true), vec![0, 9]);
+        assert_eq!(initial(1, true), vec![0]);
+        assert_eq!(initial(0, true), Vec::<usize>::new());
+        assert_eq!(initial(5, false), vec![0, 1, 2, 3, 4]);
+    }
+
     /// A smooth ratio is sampled sparsely and interpolated within the widened bracket; a jump
     /// is found by bisection and every state around it solved.
     #[test]
