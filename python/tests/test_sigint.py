@@ -15,8 +15,13 @@ import pytest
 # ended on stdout.
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
     import kappe
+
+    # Python keeps SIGINT ignored when it starts ignored (a job started with `&` by a
+    # non-interactive shell, e.g. a CI script run in the background): install the default
+    # KeyboardInterrupt handler, which is what this test is about.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
     marker, when = sys.argv[1], sys.argv[2]
     started = []
