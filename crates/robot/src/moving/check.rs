@@ -9,7 +9,7 @@ use crate::error::RobotError;
 use crate::frames::{Iso, angle_between};
 use crate::kinematics::{Joints, UR10E, within_limits};
 use crate::plan::{CLEARANCE_CUTOFF, Waypoint, plan_layers};
-use crate::planner::{Context, validate};
+use crate::planner::{Context, Select, branch, validate};
 
 /// [`crate::meshes::verify_meshes`] for a base that moves while printing (issue 27): every `stride`-th
 /// waypoint of each layer (and its first and last), the arm posed from the base's pose at that
@@ -387,12 +387,8 @@ pub fn check_moving_tolerance(
                     continue;
                 }
                 n += 1;
-                let (verts, rej) = geo.vertices_where(
-                    &off(k),
-                    li,
-                    k,
-                    crate::planner::Select::on_branch(crate::planner::branch(&w.q), min_c),
-                );
+                let (verts, rej) =
+                    geo.vertices_where(&off(k), li, k, Select::on_branch(branch(&w.q), min_c));
                 let point = format!("{at}: point {}", w.index);
                 resolver.next(&w.q, &verts, &rej, &point, &mut min_c, &mut pr);
             }
